@@ -1,0 +1,5 @@
+//! `robot-agent`: one robot's process.
+
+fn main() {
+    println!("robot-agent: not yet implemented");
+}

@@ -1,0 +1,5 @@
+//! `swarm`: launches and supervises experiments.
+
+fn main() {
+    println!("swarm: not yet implemented");
+}

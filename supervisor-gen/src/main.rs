@@ -1,0 +1,5 @@
+//! `supervisor-gen` command line.
+
+fn main() {
+    println!("supervisor-gen: not yet implemented");
+}
