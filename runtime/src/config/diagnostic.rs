@@ -13,7 +13,7 @@ use super::model::Location;
 pub struct Diagnostic {
     /// The configuration file.
     pub path: PathBuf,
-    /// Where in the file.
+    /// Where in the file; line 0 means the whole file (e.g. it cannot be read).
     pub location: Location,
     /// What is wrong.
     pub message: String,
