@@ -385,6 +385,39 @@ fn bad_boolean_is_located_at_the_attribute() {
     );
 }
 
+#[test]
+fn supervisors_list_has_no_empty_entries() {
+    let text = config(&[(
+        "<params velocity=\"12.8\"/>",
+        r#"<params supervisors="models/a.xml,,models/b.xml"/>"#,
+    )]);
+    assert_error(
+        &text,
+        "supervisors=",
+        "'supervisors' in <params> has an empty entry: 'models/a.xml,,models/b.xml' (separate supervisor files with single commas)",
+    );
+}
+
+#[test]
+fn velocity_param_is_a_non_negative_number() {
+    let text = config(&[("velocity=\"12.8\"", "velocity=\"fast\"")]);
+    assert_error(
+        &text,
+        "velocity=",
+        "invalid 'velocity' in <params>: 'fast' is not a number",
+    );
+}
+
+#[test]
+fn profile_param_is_not_empty() {
+    let text = config(&[("<params velocity=\"12.8\"/>", r#"<params profile=" "/>"#)]);
+    assert_error(
+        &text,
+        "profile=",
+        "'profile' in <params> is empty (name an agent profile, e.g. obstacle_avoidance)",
+    );
+}
+
 // ---- arena entities ----
 
 #[test]

@@ -50,6 +50,12 @@ fn thesis_example_loads_with_section_5_values() {
     assert_eq!(c.sensors[0].kind, DeviceKind::Proximity);
     assert_eq!(c.sensors[0].name, "epuck_proximity");
     assert_eq!(c.params.get("velocity"), Some("12.8"));
+    assert_eq!(
+        c.profile(),
+        None,
+        "the thesis names no profile: the agent maps the controller tag"
+    );
+    assert!(c.supervisors().is_empty());
     assert_eq!(c.params.parse::<f64>("velocity"), Ok(Some(12.8)));
 
     assert_eq!(exp.arena.size, Vec3::new(3.0, 3.0, 1.0));

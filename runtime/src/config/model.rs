@@ -270,6 +270,21 @@ impl Controller {
         self.sensors.iter().find(|d| d.kind == kind)
     }
 
+    /// `<params profile>`: the agent profile (the set of operational procedures) named explicitly; when absent
+    /// the agent picks the profile registered for [`Controller::tag`].
+    pub fn profile(&self) -> Option<&str> {
+        self.params.get("profile")
+    }
+
+    /// `<params supervisors>`: the comma-separated supervisor files (ptSCT XML models or compiled supervisors) as
+    /// written, relative to the configuration file (resolve them with [`Experiment::resolve`]); empty when absent.
+    pub fn supervisors(&self) -> Vec<&str> {
+        self.params
+            .get("supervisors")
+            .map(|list| list.split(',').map(str::trim).collect())
+            .unwrap_or_default()
+    }
+
     /// The first actuator of the given kind.
     pub fn actuator(&self, kind: DeviceKind) -> Option<&Device> {
         self.actuators.iter().find(|d| d.kind == kind)

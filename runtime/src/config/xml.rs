@@ -233,7 +233,12 @@ fn find_attribute(raw: &str, cursor: usize, key: &str) -> (usize, usize) {
             let after = value
                 .chars()
                 .next()
-                .and_then(|quote| value[1..].find(quote).map(|close| value_start + close + 2))
+                .and_then(|quote| {
+                    let width = quote.len_utf8();
+                    value[width..]
+                        .find(quote)
+                        .map(|close| value_start + close + 2 * width)
+                })
                 .unwrap_or(raw.len());
             return (at, after);
         }
