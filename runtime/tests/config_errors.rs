@@ -650,6 +650,48 @@ fn uniform_min_must_not_exceed_max() {
 }
 
 #[test]
+fn hand_placed_entity_must_be_inside_the_arena() {
+    let text = config(&[(
+        "ARENA",
+        r#"<box id="b" size="0.1,0.1,0.1"><body position="1.6,0,0"/></box>"#,
+    )]);
+    assert_error(
+        &text,
+        "<box",
+        "<box> 'b' at 1.6,0,0 is outside the arena (the arena spans x -1.5..1.5, y -1.5..1.5)",
+    );
+}
+
+#[test]
+fn uniform_range_must_stay_inside_the_arena() {
+    let position = r#"<position method="uniform" min="-1.5,-1.5,0" max="1.5,2,0"/>"#;
+    let text = config(&[(
+        "ARENA",
+        &distribution(position, CONSTANT_ORIENTATION, BOXES),
+    )]);
+    assert_error(
+        &text,
+        "<position",
+        "<distribute> positions from -1.5,-1.5,0 to 1.5,2,0 reach outside the arena (the arena spans x -1.5..1.5, y -1.5..1.5)",
+    );
+}
+
+#[test]
+fn grid_must_stay_inside_the_arena() {
+    let position = r#"<position method="grid" center="0,0,0" distances="1,1,0" layout="5,1,1"/>"#;
+    let entity = r#"<entity quantity="5" max_trials="1"><box id="b" size="0.1,0.1,0.1"/></entity>"#;
+    let text = config(&[(
+        "ARENA",
+        &distribution(position, CONSTANT_ORIENTATION, entity),
+    )]);
+    assert_error(
+        &text,
+        "<position",
+        "<distribute> positions from -2,0,0 to 2,0,0 reach outside the arena (the arena spans x -1.5..1.5, y -1.5..1.5)",
+    );
+}
+
+#[test]
 fn grid_quantity_must_fit_the_layout() {
     let position =
         r#"<position method="grid" center="0,0,0" distances="0.2,0.2,0" layout="4,4,1"/>"#;
