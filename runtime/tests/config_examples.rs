@@ -370,3 +370,73 @@ fn grid_fixture_reads_core_names_rab_and_grid() {
         Entity::Light(_)
     ));
 }
+
+#[test]
+fn tasks_4_15_sketch_loads_unchanged() {
+    let (exp, warnings) = load("runtime/tests/fixtures/good/tasks_4_15_sketch.argos");
+    assert!(warnings.is_empty(), "{:?}", messages(&warnings));
+    assert!(matches!(
+        exp.arena.floor.as_ref().map(|f| &f.source),
+        Some(FloorSource::LoopFunctions)
+    ));
+    match &exp.arena.distributions[1].template {
+        Entity::Cylinder(food) => {
+            let leds = food.leds.as_ref().expect("food carries an LED");
+            assert_eq!(leds.leds[0].offset, Vec3::new(0.0, 0.0, 0.06));
+            assert_eq!(leds.leds[0].color, Rgb { r: 255, g: 0, b: 0 });
+        }
+        other => panic!("food cylinders expected, got {other:?}"),
+    }
+}
+
+#[test]
+fn shipped_foraging_config_has_the_section_4_9_world() {
+    let (exp, warnings) = load("configs/foraging/foraging.argos");
+    assert!(warnings.is_empty(), "{:?}", messages(&warnings));
+    assert_eq!(exp.framework.ticks_per_second, 20);
+    assert_eq!(
+        exp.framework.max_ticks(),
+        Some(144_000),
+        "2 h cap at 20 ticks/s"
+    );
+    let c = exp.controller("fc").expect("controller fc");
+    assert_eq!(c.profile(), Some("foraging"));
+    for kind in [DeviceKind::Proximity, DeviceKind::Light, DeviceKind::Ground] {
+        assert_eq!(
+            c.sensor(kind).map(|d| d.noise_level),
+            Some(0.02),
+            "{kind:?}"
+        );
+    }
+    let lights: Vec<Vec3> = exp
+        .arena
+        .entities
+        .iter()
+        .filter(|p| matches!(p.entity, Entity::Light(_)))
+        .map(|p| p.pose.position)
+        .collect();
+    assert_eq!(
+        lights,
+        [-3.75, -1.25, 1.25, 3.75].map(|x| Vec3::new(x, -3.5, 1.0)),
+        "four home lights at 1 m"
+    );
+    match &exp.arena.floor.as_ref().expect("floor").source {
+        FloorSource::Regions { regions, .. } => {
+            assert_eq!(
+                (regions[0].min.y, regions[0].max.y),
+                (-5.1, -2.0),
+                "home strip up to y = -2"
+            );
+            assert_eq!(regions[0].color, Rgb { r: 0, g: 0, b: 0 });
+        }
+        other => panic!("regions floor expected, got {other:?}"),
+    }
+    let d = &exp.arena.distributions;
+    let quantities: Vec<u32> = d.iter().map(|d| d.quantity).collect();
+    assert_eq!(quantities, [40, 40, 10, 10]);
+    assert!(matches!(d[1].template, Entity::Target(_)));
+    match &d[0].position {
+        PositionMethod::Uniform { max, .. } => assert!(max.y < -2.0, "robots start in home"),
+        other => panic!("uniform robots expected, got {other:?}"),
+    }
+}
