@@ -139,6 +139,25 @@ fn arena_items_come_back_in_file_order() {
 }
 
 #[test]
+fn robots_are_numbered_in_file_order_with_generated_ids() {
+    let (exp, _) = load("configs/obstacle_avoidance/thesis_example.argos");
+    let robots = exp.arena.robots();
+    assert_eq!(robots.len(), 40);
+    assert_eq!((robots[0].index, robots[0].id.as_str()), (0, "fb0"));
+    assert_eq!((robots[39].index, robots[39].id.as_str()), (39, "fb39"));
+    assert!(robots.iter().all(|r| r.epuck.controller == "fdc"));
+
+    let (grid, _) = load("runtime/tests/fixtures/good/grid_and_rab.argos");
+    let ids: Vec<String> = grid.arena.robots().into_iter().map(|r| r.id).collect();
+    assert_eq!(
+        ids.first().map(String::as_str),
+        Some("r100"),
+        "base_num 100"
+    );
+    assert_eq!(ids.last().map(String::as_str), Some("r111"));
+}
+
+#[test]
 fn argos_example_loads_with_core_device_names() {
     let (exp, warnings) = load("configs/argos_examples/epuck_obstacleavoidance.argos");
     assert_eq!(exp.framework.ticks_per_second, 10);
@@ -439,4 +458,38 @@ fn shipped_foraging_config_has_the_section_4_9_world() {
         PositionMethod::Uniform { max, .. } => assert!(max.y < -2.0, "robots start in home"),
         other => panic!("uniform robots expected, got {other:?}"),
     }
+}
+
+#[test]
+fn hand_placed_robots_take_their_place_in_file_order() {
+    let text = r#"<argos-configuration>
+  <framework><experiment ticks_per_second="10" random_seed="3"/></framework>
+  <controllers><c id="k"/></controllers>
+  <arena size="4,4,1">
+    <e-puck id="first"><body position="0,0,0"/><controller config="k"/></e-puck>
+    <distribute>
+      <position method="uniform" min="-1,-1,0" max="1,1,0"/>
+      <orientation method="constant" values="0,0,0"/>
+      <entity quantity="2" max_trials="10"><e-puck id="d"><controller config="k"/></e-puck></entity>
+    </distribute>
+    <e-puck id="last"><body position="1,1,0"/><controller config="k"/></e-puck>
+  </arena>
+  <physics_engines><dynamics2d id="p"/></physics_engines>
+</argos-configuration>"#;
+    let (exp, _) = Experiment::parse("mixed.argos", text).expect("valid");
+    let robots: Vec<(u32, String)> = exp
+        .arena
+        .robots()
+        .into_iter()
+        .map(|r| (r.index, r.id))
+        .collect();
+    assert_eq!(
+        robots,
+        [
+            (0, "first".to_string()),
+            (1, "d0".to_string()),
+            (2, "d1".to_string()),
+            (3, "last".to_string())
+        ]
+    );
 }

@@ -409,6 +409,46 @@ impl Arena {
     }
 }
 
+/// One robot of the experiment, as [`Arena::robots`] lists them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Robot<'a> {
+    /// Position in the canonical order, from 0: the robot's slot for every process of a run.
+    pub index: u32,
+    /// The robot's id (a distribution's robots are `base id` + index, e.g. `fb0`).
+    pub id: String,
+    /// The `<e-puck>` element (for distributed robots: the template).
+    pub epuck: &'a EPuckEntity,
+}
+
+impl Arena {
+    /// Every robot in the canonical order that the launcher, the world and the agents share: arena items in file
+    /// order, each distribution expanded in index order. Robot `index` values are 0, 1, 2, ...
+    pub fn robots(&self) -> Vec<Robot<'_>> {
+        let mut robots = Vec::new();
+        for item in self.items() {
+            match item {
+                ArenaItem::Placed(PlacedEntity {
+                    entity: Entity::EPuck(epuck),
+                    ..
+                }) => {
+                    robots.push((epuck.id.clone(), epuck));
+                }
+                ArenaItem::Distribute(d) => {
+                    if let Entity::EPuck(epuck) = &d.template {
+                        robots.extend((0..d.quantity).map(|i| (d.entity_id(i), epuck)));
+                    }
+                }
+                ArenaItem::Placed(_) => {}
+            }
+        }
+        robots
+            .into_iter()
+            .zip(0u32..)
+            .map(|((id, epuck), index)| Robot { index, id, epuck })
+            .collect()
+    }
+}
+
 /// A hand-placed entity with its pose.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacedEntity {
