@@ -285,6 +285,19 @@ mod tests {
     }
 
     #[test]
+    fn attributes_on_continuation_lines_are_located_there() {
+        let text = "<experiment length=\"0\"\n            ticks_per_second=\"10\"/>";
+        let root = parse_tree(Path::new("f.argos"), text).expect("well-formed");
+        assert_eq!(
+            root.attributes["ticks_per_second"].location,
+            Location {
+                line: 2,
+                column: 13
+            }
+        );
+    }
+
+    #[test]
     fn attribute_names_inside_values_do_not_confuse_locations() {
         let text = "<a p=\"q=1\" q=\"2\"/>";
         let root = parse_tree(Path::new("f.argos"), text).expect("well-formed");
