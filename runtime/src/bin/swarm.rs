@@ -1,5 +1,113 @@
-//! `swarm`: launches and supervises experiments.
+//! `swarm`: runs experiments.
+//!
+//! `swarm run <config.argos>` starts the world and one agent process per robot, shows progress, and leaves the
+//! run directory (summary, trajectories, events, snapshot, logs). Ctrl-C stops the run cleanly: the world finishes
+//! its tick and flushes its records, and every process and shared-memory file of the run is removed.
 
-fn main() {
-    println!("swarm: not yet implemented");
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use swarm_runtime::launcher::{self, RunOptions};
+
+/// Runs swarms of robot processes executing ptSCT supervisors.
+#[derive(Debug, Parser)]
+#[command(name = "swarm", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Commands,
+}
+
+#[derive(Debug, Subcommand)]
+enum Commands {
+    /// Run an experiment: one world process and one robot-agent process per robot.
+    Run {
+        /// The experiment configuration (.argos).
+        config: PathBuf,
+        /// Number of robots (overrides the quantity of the configuration's e-puck <distribute>).
+        #[arg(long)]
+        robots: Option<u32>,
+        /// Ticks to run (overrides the configuration's experiment length).
+        #[arg(long)]
+        ticks: Option<u64>,
+        /// Run seed (overrides the configuration's random_seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Run directory (default: runs/<config name>-<unix seconds>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Milliseconds a tick waits for a missing command before it goes on without it.
+        #[arg(long = "tick-deadline-ms")]
+        tick_deadline_ms: Option<u64>,
+        /// Do not draw a progress bar.
+        #[arg(long)]
+        no_progress: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Commands::Run {
+            config,
+            robots,
+            ticks,
+            seed,
+            out,
+            tick_deadline_ms,
+            no_progress,
+        } => {
+            let stop = Arc::new(AtomicBool::new(false));
+            let flag = Arc::clone(&stop);
+            ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+                .context("installing the Ctrl-C handler")?;
+            let options = RunOptions {
+                config: config.clone(),
+                robots,
+                ticks,
+                seed,
+                out,
+                progress: !no_progress,
+                tick_deadline: tick_deadline_ms.map(Duration::from_millis),
+            };
+            let report = launcher::run(&options, stop)
+                .with_context(|| format!("running {}", config.display()))?;
+            let ticking = (report.wall_seconds - report.time_to_first_tick_seconds).max(f64::EPSILON);
+            let steps = f64::from(report.robots) * report.ticks as f64;
+            println!(
+                "{} after {} ticks: {} robots, seed {}, {:.1} s ({:.2} s to the first tick), {:.0} robot-steps/s, \
+                 {} deaths; records in {}",
+                if report.interrupted { "stopped" } else { "finished" },
+                report.ticks,
+                report.robots,
+                report.seed,
+                report.wall_seconds,
+                report.time_to_first_tick_seconds,
+                steps / ticking,
+                report.deaths.len(),
+                report.out_dir.display()
+            );
+            Ok(())
+        }
+    }
 }

@@ -13,6 +13,7 @@ pub mod diagnostic;
 pub mod model;
 mod parse;
 mod registry;
+mod robot_count;
 mod suggest;
 mod values;
 mod xml;

@@ -1,0 +1,79 @@
+//! The child processes of a run.
+//!
+//! Children run in their own process group, so a Ctrl-C in the terminal reaches only the launcher, which then
+//! stops the run in order (world first, so it flushes its records). Each child also gets `SIGKILL` from the kernel
+//! when the launcher dies (`PR_SET_PDEATHSIG`), so no robot outlives a killed launcher. Dropping [`Children`]
+//! kills and reaps every child that is still running.
+
+use std::os::unix::process::CommandExt;
+use std::process::{Child, Command, ExitStatus};
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+
+/// Starts `command` as a supervised child: own process group, killed with the launcher.
+pub fn spawn(command: &mut Command) -> std::io::Result<Child> {
+    command.process_group(0);
+    // SAFETY: the closure runs between fork and exec and only makes the async-signal-safe prctl system call.
+    unsafe {
+        command.pre_exec(|| {
+            nix::sys::prctl::set_pdeathsig(Signal::SIGKILL).map_err(std::io::Error::from)
+        });
+    }
+    command.spawn()
+}
+
+/// Sends `signal` to a child; a child that already exited is not an error.
+pub fn signal(child: &Child, signal: Signal) {
+    if let Ok(pid) = i32::try_from(child.id()) {
+        let _ = kill(Pid::from_raw(pid), signal);
+    }
+}
+
+/// A run's processes: the world and one agent per robot (by robot index).
+#[derive(Debug, Default)]
+pub struct Children {
+    /// The world process, while it runs.
+    pub world: Option<Child>,
+    /// Agent processes by robot index; `None` once reaped.
+    pub agents: Vec<Option<Child>>,
+}
+
+impl Children {
+    /// Agents that exited since the last call, with their robot index and exit status (reaped).
+    pub fn reap_agents(&mut self) -> Vec<(u32, ExitStatus)> {
+        let mut exited = Vec::new();
+        for (robot, slot) in self.agents.iter_mut().enumerate() {
+            if let Some(child) = slot
+                && let Ok(Some(status)) = child.try_wait()
+            {
+                exited.push((robot as u32, status));
+                *slot = None;
+            }
+        }
+        exited
+    }
+
+    /// Number of agent processes not yet reaped.
+    pub fn agents_running(&self) -> usize {
+        self.agents.iter().filter(|a| a.is_some()).count()
+    }
+
+    /// Kills and reaps every child still running.
+    pub fn kill_all(&mut self) {
+        for child in self.agents.iter_mut().flatten().chain(self.world.iter_mut()) {
+            signal(child, Signal::SIGKILL);
+        }
+        for child in self.agents.iter_mut().flatten().chain(self.world.iter_mut()) {
+            let _ = child.wait();
+        }
+        self.agents.clear();
+        self.world = None;
+    }
+}
+
+impl Drop for Children {
+    fn drop(&mut self) {
+        self.kill_all();
+    }
+}

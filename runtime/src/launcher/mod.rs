@@ -1,0 +1,511 @@
+//! The launcher behind `swarm run`: validates an experiment, starts the world process and one robot-agent
+//! process per robot, supervises them, and leaves a complete run directory and no shared-memory files behind.
+//!
+//! It never simulates or controls anything itself: the world and the agents are separate programs
+//! ([`binaries`]) that speak the [`process_args`] and [`world_report`] contracts with it.
+//!
+//! Order of a run: load and validate the configuration (all errors at once, located) -> resolve seed, ticks and
+//! robots -> create the run directory -> start the world (it creates every shared-memory service with limits
+//! for N robots and says `ready`) -> start the agents -> follow the world's tick reports on a progress bar; an agent
+//! that dies is reported to the world at once on its standard input (`dead <robot>`) -> when the world says
+//! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory.
+
+pub mod binaries;
+mod children;
+pub mod process_args;
+pub mod run_dir;
+pub mod world_report;
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use nix::sys::signal::Signal;
+
+use crate::config::{ConfigErrors, Experiment};
+use crate::transport::RunSpec;
+use binaries::{Binaries, BinariesError};
+use children::Children;
+use process_args::{AgentArgs, RunArgs, WorldArgs};
+use world_report::WorldReport;
+
+/// How long the launcher waits for the world to create its services.
+const WORLD_READY_TIMEOUT: Duration = Duration::from_secs(60);
+/// How long agents get to exit by themselves after the world finished.
+const AGENT_EXIT_GRACE: Duration = Duration::from_secs(5);
+/// How often the supervision loop looks at its children when the world is quiet.
+const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
+/// Lines of an agent's log quoted when it fails to start.
+const LOG_LINES_QUOTED: usize = 8;
+
+/// What `swarm run` was asked to do.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// The experiment configuration.
+    pub config: PathBuf,
+    /// Number of robots, overriding the configuration's e-puck `<distribute>` quantity.
+    pub robots: Option<u32>,
+    /// Ticks to run, overriding the configuration's `length`.
+    pub ticks: Option<u64>,
+    /// Run seed, overriding the configuration's `random_seed`.
+    pub seed: Option<u64>,
+    /// Run directory (default `runs/<config name>-<unix seconds>`).
+    pub out: Option<PathBuf>,
+    /// Show a progress bar on the terminal.
+    pub progress: bool,
+    /// How long a tick waits for a missing command (default: the transport's).
+    pub tick_deadline: Option<Duration>,
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    /// The run directory.
+    pub out_dir: PathBuf,
+    /// The seed used.
+    pub seed: u64,
+    /// Number of robots.
+    pub robots: u32,
+    /// Ticks completed.
+    pub ticks: u64,
+    /// Wall time from the start of the world to the end of the run, in seconds.
+    pub wall_seconds: f64,
+    /// Wall time from the start of the world to the first completed tick, in seconds.
+    pub time_to_first_tick_seconds: f64,
+    /// Whether the run was stopped early by Ctrl-C.
+    pub interrupted: bool,
+    /// Robots whose agent died during the run, with the tick the world had completed at the time.
+    pub deaths: Vec<Death>,
+}
+
+/// An agent that died while the run went on.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Death {
+    /// Robot index.
+    pub robot: u32,
+    /// Last tick the world had completed when the launcher saw the death.
+    pub after_tick: u64,
+    /// How the process ended.
+    pub status: String,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LaunchError {
+    /// The configuration is invalid.
+    #[error("{0}")]
+    Config(#[from] ConfigErrors),
+    /// The configuration has no robot to run.
+    #[error("{path}: the arena has no e-puck, so there is nothing to run")]
+    NoRobots {
+        /// The configuration.
+        path: PathBuf,
+    },
+    /// The world or agent programs are missing.
+    #[error(transparent)]
+    Binaries(#[from] BinariesError),
+    /// A file or process operation failed.
+    #[error("{what}: {source}")]
+    Io {
+        /// What the launcher was doing.
+        what: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The world process ended before it was ready or before the experiment finished.
+    #[error("the world process ended ({status}) {when}")]
+    WorldDied {
+        /// Exit status.
+        status: String,
+        /// At which point of the run.
+        when: String,
+    },
+    /// The world did not say `ready` in time.
+    #[error("the world process did not create its services within {0:?}")]
+    WorldNotReady(Duration),
+    /// An agent failed before the first tick.
+    #[error("robot {robot} ({id}) failed to start ({status}):\n{log}")]
+    AgentFailed {
+        /// Robot index.
+        robot: u32,
+        /// Robot id from the configuration.
+        id: String,
+        /// Exit status.
+        status: String,
+        /// The end of the agent's log.
+        log: String,
+    },
+}
+
+fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> LaunchError {
+    let what = what.into();
+    move |source| LaunchError::Io { what, source }
+}
+
+/// Removes every shared-memory file of a run when dropped, whatever happened before.
+struct SharedMemoryGuard(RunSpec);
+
+impl Drop for SharedMemoryGuard {
+    fn drop(&mut self) {
+        if let Err(e) = self.0.cleanup() {
+            tracing::warn!("removing the run's shared memory: {e}");
+        }
+    }
+}
+
+/// Runs one experiment to its end; `stop` set (e.g. by Ctrl-C) ends it early and cleanly.
+pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, LaunchError> {
+    let (experiment, warnings) = Experiment::load(&options.config)?;
+    for warning in &warnings {
+        tracing::warn!("{warning}");
+    }
+    let experiment = match options.robots {
+        Some(n) => experiment.with_robot_count(n)?,
+        None => experiment,
+    };
+    let roster = experiment.arena.robots();
+    if roster.is_empty() {
+        return Err(LaunchError::NoRobots {
+            path: options.config.clone(),
+        });
+    }
+    let robots = roster.len() as u32;
+    let seed = options
+        .seed
+        .or(experiment.framework.random_seed)
+        .unwrap_or_else(clock_seed);
+    if options.seed.is_none() && experiment.framework.random_seed.is_none() {
+        tracing::warn!(seed, "no random_seed in the configuration: using one from the clock");
+    }
+    let ticks = options
+        .ticks
+        .or(experiment.framework.max_ticks())
+        .unwrap_or(0);
+    let out_dir = run_dir::create(options.out.as_deref(), &options.config)
+        .map_err(io("creating the run directory"))?;
+    let binaries = Binaries::locate()?;
+    let spec = RunSpec::unique();
+    let _shared_memory = SharedMemoryGuard(spec.clone());
+    let run_args = RunArgs {
+        run: spec.name().to_owned(),
+        iox_root: spec.root_dir().to_path_buf(),
+    };
+    let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
+    tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
+
+    let started = Instant::now();
+    let mut children = Children::default();
+    let world_args = WorldArgs {
+        run: run_args.clone(),
+        config: config.clone(),
+        seed,
+        ticks,
+        robots: options.robots,
+        out: out_dir.clone(),
+        tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
+        join_timeout_ms: 120_000,
+    };
+    let mut world = children::spawn(
+        Command::new(&binaries.world)
+            .args(world_args.to_args())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped()),
+    )
+    .map_err(io(format!("starting {}", binaries.world.display())))?;
+    let world_stdin = world.stdin.take();
+    let reports = follow_reports(world.stdout.take());
+    children.world = Some(world);
+
+    wait_ready(&mut children, &reports, robots)?;
+    children.agents.reserve(roster.len());
+    for (robot, entry) in roster.iter().enumerate() {
+        let agent_args = AgentArgs {
+            run: run_args.clone(),
+            robot: robot as u32,
+            config: config.clone(),
+            controller: entry.epuck.controller.clone(),
+            seed,
+        };
+        let log_path = run_dir::agent_log(&out_dir, robot as u32);
+        let log = std::fs::File::create(&log_path).map_err(io(format!("creating {}", log_path.display())))?;
+        let child = children::spawn(
+            Command::new(&binaries.agent)
+                .args(agent_args.to_args())
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(log),
+        )
+        .map_err(io(format!("starting {}", binaries.agent.display())))?;
+        children.agents.push(Some(child));
+    }
+
+    let progress = progress_bar(options.progress, ticks, robots);
+    let mut supervision = Supervision {
+        children,
+        world_stdin,
+        roster_ids: roster.iter().map(|r| r.id.clone()).collect(),
+        out_dir: out_dir.clone(),
+        progress,
+        started,
+        first_tick: None,
+        last_tick: 0,
+        deaths: Vec::new(),
+        interrupted: false,
+    };
+    supervision.follow(&reports, &stop)?;
+    supervision.collect_agents();
+    supervision.progress.finish_and_clear();
+
+    let report = RunReport {
+        out_dir: out_dir.clone(),
+        seed,
+        robots,
+        ticks: supervision.last_tick,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        time_to_first_tick_seconds: supervision
+            .first_tick
+            .map_or(0.0, |t| t.duration_since(started).as_secs_f64()),
+        interrupted: supervision.interrupted,
+        deaths: supervision.deaths.clone(),
+    };
+    complete_summary(&out_dir, &report)?;
+    Ok(report)
+}
+
+/// A seed from the clock, for configurations that ask for one.
+fn clock_seed() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(1, |d| d.as_nanos() as u64)
+        .max(1)
+}
+
+/// Reads the world's reports on a thread so the launcher can wait on them with timeouts.
+fn follow_reports(stdout: Option<std::process::ChildStdout>) -> Receiver<WorldReport> {
+    let (sender, receiver) = mpsc::channel();
+    if let Some(stdout) = stdout {
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines() {
+                let Ok(line) = line else { break };
+                if let Some(report) = WorldReport::parse(&line)
+                    && sender.send(report).is_err()
+                {
+                    break;
+                }
+            }
+        });
+    }
+    receiver
+}
+
+fn exit_status(status: ExitStatus) -> String {
+    status.to_string()
+}
+
+/// Waits for the world's `ready`, failing early if it dies.
+fn wait_ready(
+    children: &mut Children,
+    reports: &Receiver<WorldReport>,
+    robots: u32,
+) -> Result<(), LaunchError> {
+    let deadline = Instant::now() + WORLD_READY_TIMEOUT;
+    loop {
+        match reports.recv_timeout(SUPERVISION_PERIOD) {
+            Ok(WorldReport::Ready { robots: ready }) if ready == robots => return Ok(()),
+            Ok(WorldReport::Ready { robots: ready }) => {
+                return Err(LaunchError::WorldDied {
+                    status: format!("ready for {ready} robots"),
+                    when: format!("while the launcher expected {robots}"),
+                });
+            }
+            Ok(_) | Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {}
+        }
+        if let Some(world) = children.world.as_mut()
+            && let Ok(Some(status)) = world.try_wait()
+        {
+            children.world = None;
+            return Err(LaunchError::WorldDied {
+                status: exit_status(status),
+                when: "before it was ready (its error is above)".into(),
+            });
+        }
+        if Instant::now() > deadline {
+            return Err(LaunchError::WorldNotReady(WORLD_READY_TIMEOUT));
+        }
+    }
+}
+
+fn progress_bar(visible: bool, ticks: u64, robots: u32) -> ProgressBar {
+    if !visible {
+        return ProgressBar::hidden();
+    }
+    let bar = if ticks > 0 {
+        ProgressBar::new(ticks)
+    } else {
+        ProgressBar::new_spinner()
+    };
+    let template = if ticks > 0 {
+        "{elapsed_precise} [{bar:40}] tick {pos}/{len} {per_sec} {msg}"
+    } else {
+        "{elapsed_precise} {spinner} tick {pos} {per_sec} {msg}"
+    };
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(format!("{robots}/{robots} robots alive"));
+    bar
+}
+
+/// The launcher's view of a running experiment.
+struct Supervision {
+    children: Children,
+    world_stdin: Option<ChildStdin>,
+    roster_ids: Vec<String>,
+    out_dir: PathBuf,
+    progress: ProgressBar,
+    started: Instant,
+    first_tick: Option<Instant>,
+    last_tick: u64,
+    deaths: Vec<Death>,
+    interrupted: bool,
+}
+
+impl Supervision {
+    /// Follows the run until the world finishes (or is stopped and finishes), handling deaths on the way.
+    fn follow(&mut self, reports: &Receiver<WorldReport>, stop: &AtomicBool) -> Result<(), LaunchError> {
+        let mut stop_sent = false;
+        loop {
+            if stop.load(Ordering::Relaxed) && !stop_sent {
+                stop_sent = true;
+                self.interrupted = true;
+                tracing::info!("stopping: the world finishes its tick and flushes its records");
+                if let Some(world) = &self.children.world {
+                    children::signal(world, Signal::SIGTERM);
+                }
+            }
+            match reports.recv_timeout(SUPERVISION_PERIOD) {
+                Ok(WorldReport::Tick { tick, dead, .. }) => {
+                    if self.first_tick.is_none() {
+                        self.first_tick = Some(Instant::now());
+                        tracing::debug!(
+                            after = ?self.started.elapsed(),
+                            "first tick"
+                        );
+                    }
+                    self.last_tick = tick;
+                    self.progress.set_position(tick);
+                    let total = self.roster_ids.len() as u32;
+                    self.progress
+                        .set_message(format!("{}/{total} robots alive", total.saturating_sub(dead)));
+                }
+                Ok(WorldReport::Finished { ticks }) => {
+                    self.last_tick = ticks;
+                    self.wait_world()?;
+                    return Ok(());
+                }
+                Ok(WorldReport::Ready { .. }) | Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => {
+                    // The world closed its output: it is exiting; its status says how.
+                    self.wait_world()?;
+                    return Err(LaunchError::WorldDied {
+                        status: "without reporting the end of the experiment".into(),
+                        when: format!("after tick {}", self.last_tick),
+                    });
+                }
+            }
+            self.handle_agent_exits()?;
+        }
+    }
+
+    /// Reaps exited agents: before the first tick an exit is a failed start; afterwards it is a death the world
+    /// hears of at once.
+    fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
+        for (robot, status) in self.children.reap_agents() {
+            if self.first_tick.is_none() {
+                let log = run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
+                return Err(LaunchError::AgentFailed {
+                    robot,
+                    id: self.roster_ids.get(robot as usize).cloned().unwrap_or_default(),
+                    status: exit_status(status),
+                    log,
+                });
+            }
+            tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
+            if let Some(stdin) = self.world_stdin.as_mut() {
+                let _ = writeln!(stdin, "dead {robot}");
+            }
+            self.deaths.push(Death {
+                robot,
+                after_tick: self.last_tick,
+                status: exit_status(status),
+            });
+        }
+        Ok(())
+    }
+
+    /// Waits for the world to exit and checks it succeeded.
+    fn wait_world(&mut self) -> Result<(), LaunchError> {
+        let Some(mut world) = self.children.world.take() else {
+            return Ok(());
+        };
+        let status = world.wait().map_err(io("waiting for the world process"))?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(LaunchError::WorldDied {
+                status: exit_status(status),
+                when: format!("after tick {}", self.last_tick),
+            })
+        }
+    }
+
+    /// Lets agents exit by themselves (the world's end tells them), then kills the rest.
+    fn collect_agents(&mut self) {
+        let deadline = Instant::now() + AGENT_EXIT_GRACE;
+        while self.children.agents_running() > 0 && Instant::now() < deadline {
+            self.children.reap_agents();
+            std::thread::sleep(SUPERVISION_PERIOD);
+        }
+        let stragglers = self.children.agents_running();
+        if stragglers > 0 {
+            tracing::warn!(stragglers, "agents did not exit after the run; killing them");
+        }
+        self.children.kill_all();
+    }
+}
+
+/// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none).
+fn complete_summary(out_dir: &Path, report: &RunReport) -> Result<(), LaunchError> {
+    let path = out_dir.join("summary.json");
+    let mut summary = std::fs::read_to_string(&path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .filter(serde_json::Value::is_object)
+        .unwrap_or_else(|| serde_json::json!({}));
+    let deaths: Vec<serde_json::Value> = report
+        .deaths
+        .iter()
+        .map(|d| serde_json::json!({"robot": d.robot, "after_tick": d.after_tick, "status": d.status}))
+        .collect();
+    if let Some(object) = summary.as_object_mut() {
+        object.insert("seed".into(), report.seed.into());
+        object.insert("robots".into(), report.robots.into());
+        object.insert("ticks".into(), report.ticks.into());
+        object.insert("wall_seconds".into(), report.wall_seconds.into());
+        object.insert(
+            "time_to_first_tick_seconds".into(),
+            report.time_to_first_tick_seconds.into(),
+        );
+        object.insert("interrupted".into(), report.interrupted.into());
+        object.insert("deaths".into(), deaths.into());
+    }
+    let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    std::fs::write(&path, text + "\n").map_err(io(format!("writing {}", path.display())))
+}

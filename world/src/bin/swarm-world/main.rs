@@ -1,0 +1,187 @@
+//! `swarm-world`: the world process of a run.
+//!
+//! Builds the arena from the experiment, creates the run's shared-memory services for N robots, says `ready`,
+//! waits for the agents, then runs the lockstep: sense every robot into the shared frames, wake the agents, wait
+//! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
+//! Progress goes to standard output as [`WorldReport`] lines for the launcher; `dead <robot>` lines on standard
+//! input are the launcher's death notices. SIGINT/SIGTERM end the run after the current tick with every record
+//! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`.
+
+mod events;
+
+use std::io::{BufRead, Write};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Parser;
+use swarm_runtime::config::Experiment;
+use swarm_runtime::launcher::process_args::WorldArgs;
+use swarm_runtime::launcher::world_report::WorldReport;
+use swarm_runtime::messages::ActuatorCommand;
+use swarm_runtime::transport::{DeathNotices, LinkConfig, RunSpec, WorldLink};
+use swarm_world::World;
+use swarm_world::recorder::Recorder;
+
+use events::EventsWriter;
+
+/// Minimum interval between two progress reports to the launcher.
+const REPORT_INTERVAL: Duration = Duration::from_millis(50);
+
+/// The world process of a swarm run.
+#[derive(Debug, Parser)]
+#[command(name = "swarm-world", version, about)]
+struct Cli {
+    #[command(flatten)]
+    args: WorldArgs,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(&Cli::parse().args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("swarm-world: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Prints one report line for the launcher.
+fn report(line: WorldReport) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{line}");
+    let _ = out.flush();
+}
+
+/// Forwards the launcher's `dead <robot>` lines to the transport at once (so the current tick stops waiting) and
+/// to the main loop (which turns the robot into an inert body between ticks).
+fn follow_death_notices(notices: DeathNotices) -> Receiver<u32> {
+    let (sender, receiver) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines() {
+            let Ok(line) = line else { break };
+            let Some(robot) = line.strip_prefix("dead ").and_then(|r| r.trim().parse::<u32>().ok()) else {
+                continue;
+            };
+            if let Err(e) = notices.mark_dead(robot) {
+                tracing::warn!("ignoring death notice '{line}': {e}");
+                continue;
+            }
+            if sender.send(robot).is_err() {
+                break;
+            }
+        }
+    });
+    receiver
+}
+
+fn run(args: &WorldArgs) -> anyhow::Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).context("installing the stop handler")?;
+
+    let (experiment, _warnings) = Experiment::load(&args.config)?;
+    let experiment = match args.robots {
+        Some(n) => experiment.with_robot_count(n)?,
+        None => experiment,
+    };
+    let mut world = World::new(&experiment, args.seed)?;
+    let robots = world.robot_count();
+    let roster: Vec<(String, String)> = experiment
+        .arena
+        .robots()
+        .into_iter()
+        .map(|r| (r.id, r.epuck.controller.clone()))
+        .collect();
+
+    let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;
+    let mut link_config = LinkConfig::new(robots as u32);
+    if let Some(ms) = args.tick_deadline_ms {
+        link_config.tick_deadline = Duration::from_millis(ms);
+    }
+    let mut link = WorldLink::create(&run, link_config)?;
+    let deaths = follow_death_notices(link.death_notices());
+    let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
+    let mut events = EventsWriter::create(&args.out, &roster)?;
+    recorder.record_initial(&world)?;
+    report(WorldReport::Ready {
+        robots: robots as u32,
+    });
+
+    link.wait_for_agents(Duration::from_millis(args.join_timeout_ms))
+        .context("waiting for the robot agents to join")?;
+    let started = Instant::now();
+    let mut commands: Vec<ActuatorCommand> = (0..robots).map(|i| ActuatorCommand::idle(i as u32, 0)).collect();
+    let mut has_command = vec![false; robots];
+    let mut dead = vec![false; robots];
+    let mut robot_steps: u64 = 0;
+    let mut last_report = Instant::now();
+    let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
+    while !stop.load(Ordering::Relaxed) && !world.is_finished() && (args.ticks == 0 || link.tick() < args.ticks) {
+        for robot in deaths.try_iter() {
+            if let Some(flag) = dead.get_mut(robot as usize) {
+                *flag = true;
+                world.set_alive(world.robot_id(robot as usize), false);
+            }
+        }
+        let tick_started = Instant::now();
+        let outcome = link.tick_with(|_, frames| world.sense(frames))?;
+        for robot in 0..robots {
+            match link.command(robot as u32) {
+                Some(command) => {
+                    commands[robot] = *command;
+                    has_command[robot] = true;
+                    events.record(robot, command)?;
+                }
+                None => has_command[robot] = false,
+            }
+        }
+        world.act_and_step(&commands, &has_command);
+        recorder.record(&world)?;
+        events.flush()?;
+        tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
+        robot_steps += u64::from(outcome.answered);
+        if last_report.elapsed() >= REPORT_INTERVAL {
+            last_report = Instant::now();
+            report(WorldReport::Tick {
+                tick: outcome.tick,
+                answered: outcome.answered,
+                missing: outcome.missing,
+                dead: outcome.dead,
+            });
+        }
+    }
+    let ticking = started.elapsed().as_secs_f64();
+    let ticks = link.tick();
+    let extra = serde_json::json!({
+        "robot_steps": robot_steps,
+        "ticking_seconds": ticking,
+        "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
+        "tick_micros_p50": percentile(&mut tick_micros, 0.50),
+        "tick_micros_p99": percentile(&mut tick_micros, 0.99),
+    });
+    recorder.finish(&world, extra)?;
+    events.flush()?;
+    report(WorldReport::Finished { ticks });
+    Ok(())
+}
+
+/// The `q` quantile of the tick times in microseconds (0 when there were no ticks).
+fn percentile(samples: &mut [u32], q: f64) -> u32 {
+    if samples.is_empty() {
+        return 0;
+    }
+    samples.sort_unstable();
+    let rank = ((samples.len() - 1) as f64 * q).round() as usize;
+    samples[rank.min(samples.len() - 1)]
+}
