@@ -6,3 +6,5 @@
 //! `shared/reference/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
 //!
 //! This crate depends on nothing else of the workspace.
+
+pub mod automaton;
