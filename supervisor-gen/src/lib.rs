@@ -8,3 +8,4 @@
 //! This crate depends on nothing else of the workspace.
 
 pub mod automaton;
+pub mod compiled;
