@@ -9,3 +9,6 @@
 
 pub mod automaton;
 pub mod compiled;
+pub mod normalise;
+pub mod product;
+pub mod trim;
