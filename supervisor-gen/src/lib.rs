@@ -9,6 +9,8 @@
 
 pub mod automaton;
 pub mod compiled;
+pub mod minimise;
 pub mod normalise;
 pub mod product;
+pub mod supc;
 pub mod trim;
