@@ -7,6 +7,7 @@
 //!
 //! This crate depends on nothing else of the workspace.
 
+pub mod architecture;
 pub mod automaton;
 pub mod compiled;
 pub mod minimise;
