@@ -527,6 +527,24 @@ impl SupervisorSet {
     }
 }
 
+/// MemCons (section 9) of automata that would be compiled over `events`, without compiling them.
+pub fn mem_cons_of(events: &EventTable, sups: &[&Automaton]) -> usize {
+    let (e, n) = (events.len(), sups.len());
+    let (mut s, mut t, mut tc) = (0, 0, 0);
+    for a in sups {
+        s += a.state_count();
+        for x in a.states() {
+            let trs = a.transitions(x);
+            t += trs.len();
+            tc += trs
+                .iter()
+                .filter(|tr| events.is_controllable(tr.event))
+                .count();
+        }
+    }
+    (s + 3 * t) + 2 * (s + 2 * tc) + e + (e + 2) * n
+}
+
 fn check_name(name: &str) -> Result<(), CodegenError> {
     if name.len() > usize::from(u16::MAX) {
         return Err(CodegenError::NameTooLong {
@@ -988,6 +1006,7 @@ mod tests {
             "payload differs: {bytes:02X?}"
         );
         assert_eq!(set.mem_cons(), 57);
+        assert_eq!(mem_cons_of(&ev, &[&g]), 57);
         // Header: magic, version, counts, 4 one-letter event names, one supervisor entry.
         assert_eq!(bytes.len() - 57, 10 + 4 * 3 + (2 + 7 + 2));
         assert_eq!(&bytes[..4], b"PTSC");

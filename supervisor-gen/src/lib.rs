@@ -12,6 +12,7 @@ pub mod automaton;
 pub mod compiled;
 pub mod minimise;
 pub mod normalise;
+pub mod pipeline;
 pub mod product;
 pub mod supc;
 pub mod trim;
