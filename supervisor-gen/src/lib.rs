@@ -6,3 +6,13 @@
 //! `shared/reference/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
 //!
 //! This crate depends on nothing else of the workspace.
+
+pub mod architecture;
+pub mod automaton;
+pub mod compiled;
+pub mod minimise;
+pub mod normalise;
+pub mod pipeline;
+pub mod product;
+pub mod supc;
+pub mod trim;
