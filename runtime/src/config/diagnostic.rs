@@ -13,7 +13,7 @@ use super::model::Location;
 pub struct Diagnostic {
     /// The configuration file.
     pub path: PathBuf,
-    /// Where in the file.
+    /// Where in the file; line 0 means the whole file (e.g. it cannot be read).
     pub location: Location,
     /// What is wrong.
     pub message: String,
@@ -41,13 +41,17 @@ impl Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}: {}",
-            self.path.display(),
-            self.location,
-            self.message
-        )?;
+        if self.location.line == 0 {
+            write!(f, "{}: {}", self.path.display(), self.message)?;
+        } else {
+            write!(
+                f,
+                "{}:{}: {}",
+                self.path.display(),
+                self.location,
+                self.message
+            )?;
+        }
         if let Some(hint) = &self.hint {
             write!(f, " ({hint})")?;
         }
