@@ -14,7 +14,8 @@ use crate::media::rab::RabMedium;
 pub const MAX_WHEEL_SPEED_CM_S: f32 = 12.8;
 /// Distance between the wheels in metres.
 pub const INTER_WHEEL_DISTANCE: f32 = 0.053;
-/// Largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm).
+/// Default largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm);
+/// the `virtual_gripper` actuator's `pickup_gap` overrides it.
 pub const GRIPPER_REACH: f32 = 0.007;
 /// Gap in metres between the robot's edge and a target it drops in front of itself.
 pub const DROP_GAP: f32 = 0.001;
@@ -100,7 +101,7 @@ pub fn target_in_reach(arena: &Arena, id: RobotId) -> Option<TargetId> {
         .enumerate()
         .filter(|(_, t)| t.state == TargetState::InArena)
         .map(|(i, t)| (i, t.placed.gap_to_disc(robot.position, ROBOT_RADIUS)))
-        .filter(|&(_, gap)| gap <= GRIPPER_REACH)
+        .filter(|&(_, gap)| gap <= robot.devices.gripper_reach)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| TargetId(i as u32))
 }

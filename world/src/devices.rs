@@ -3,6 +3,8 @@
 //! The world computes only the sensors a controller declares (ARGoS does the same); the fields of the frame that
 //! belong to undeclared sensors keep their empty values. Built from the `<controllers>` section of the config.
 
+use crate::actuators::GRIPPER_REACH;
+
 /// Options of the `epuck_proximity` sensor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProximityOptions {
@@ -45,6 +47,8 @@ pub struct Devices {
     pub rab: Option<RabOptions>,
     /// Multiplicative Gaussian wheel noise `noise_std_dev` (0 = none).
     pub wheel_noise_std_dev: f32,
+    /// Largest edge-to-edge gap in metres at which the virtual gripper picks a target (`pickup_gap`).
+    pub gripper_reach: f32,
 }
 
 impl Devices {
@@ -63,6 +67,7 @@ impl Devices {
             loss_probability: 0.0,
         }),
         wheel_noise_std_dev: 0.0,
+        gripper_reach: GRIPPER_REACH,
     };
 
     /// Only wheels and proximity sensors, as in the thesis' obstacle-avoidance configuration.
@@ -77,5 +82,6 @@ impl Devices {
         camera: None,
         rab: None,
         wheel_noise_std_dev: 0.0,
+        gripper_reach: GRIPPER_REACH,
     };
 }

@@ -10,6 +10,7 @@ use swarm_runtime::config::{
 };
 use swarm_runtime::messages::{PHEROMONE_CHANNELS, RAB_PAYLOAD_BYTES, Rgb};
 
+use crate::actuators::GRIPPER_REACH;
 use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions};
 use crate::distribute::{self, outline};
 use crate::entities::{FloorRegion, Light};
@@ -88,6 +89,14 @@ pub fn devices(exp: &Experiment, c: &Controller) -> Result<Devices, WorldError> 
             })
         }
     };
+    let gripper_reach = match c.actuator(DeviceKind::VirtualGripper) {
+        None => GRIPPER_REACH,
+        Some(d) => d
+            .attributes
+            .parse::<f64>("pickup_gap")
+            .map_err(|e| invalid(exp, e.location, e.message))?
+            .map_or(GRIPPER_REACH, |g| g as f32),
+    };
     Ok(Devices {
         proximity,
         light: c.sensor(DeviceKind::Light).map(|d| d.noise_level as f32),
@@ -101,6 +110,7 @@ pub fn devices(exp: &Experiment, c: &Controller) -> Result<Devices, WorldError> 
         wheel_noise_std_dev: c
             .actuator(DeviceKind::Wheels)
             .map_or(0.0, |d| d.noise_std_dev as f32),
+        gripper_reach,
     })
 }
 

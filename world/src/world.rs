@@ -267,6 +267,11 @@ impl World {
         self.max_ticks = ticks;
     }
 
+    /// The tick limit (`None`: only the loop functions stop the experiment).
+    pub fn max_ticks(&self) -> Option<u64> {
+        self.max_ticks
+    }
+
     /// Whether the experiment is over: the tick limit is reached or the loop functions say so.
     pub fn is_finished(&self) -> bool {
         self.max_ticks.is_some_and(|m| self.arena.tick >= m)
@@ -311,17 +316,22 @@ impl World {
         };
         for (i, (robot, frame)) in arena.robots.iter_mut().zip(frames.iter_mut()).enumerate() {
             let me = i as u32;
+            if !robot.alive {
+                // A dead robot senses nothing; its frame only says so.
+                *frame = SensorFrame::empty(me);
+                frame.alive = 0;
+            }
             frame.tick = tick;
             frame.robot = me;
-            frame.alive = u8::from(robot.alive);
             frame.gripper_holding = u8::from(robot.carrying.is_some());
             frame.position = [robot.position.x, robot.position.y];
             frame.heading = robot.heading;
-            frame.camera_len = 0;
-            frame.rab_len = 0;
             if !robot.alive {
                 continue;
             }
+            frame.alive = 1;
+            frame.camera_len = 0;
+            frame.rab_len = 0;
             let (pos, heading) = (robot.position, robot.heading);
             let observer = Observer {
                 me,

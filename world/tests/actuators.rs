@@ -181,3 +181,32 @@ fn robot_without_a_command_holds_still() {
     world.act_and_step(&[wheels(10.0, 10.0)], &[false]);
     assert_eq!(world.arena.robots[0].position, Vec2::ZERO);
 }
+
+#[test]
+fn robot_pushes_a_movable_box_ahead_of_it() {
+    let mut b = builder();
+    b.robot("r", "c", Vec2::ZERO, 0.0, Devices::PROXIMITY_ONLY);
+    let crate_box = Placed::new(
+        Shape::Rect {
+            half: Vec2::splat(0.05),
+        },
+        Vec2::new(0.1, 0.0),
+        0.0,
+    );
+    b.obstacle(
+        "crate",
+        crate_box,
+        0.1,
+        swarm_world::physics::Motion::Movable { mass: 0.05 },
+    );
+    let mut world = b.build();
+    drive(&mut world, 40, wheels(12.8, 12.8));
+    let pushed = world.arena.obstacles[0].placed.position;
+    let robot = world.arena.robots[0].position;
+    assert!(pushed.x > 0.2, "the box moved ahead: {pushed:?}");
+    assert!(
+        pushed.x - robot.x >= ROBOT_RADIUS + 0.05 - 0.002,
+        "and stays in front of the robot"
+    );
+    assert!(world.arena.robots[0].collisions >= 1);
+}
