@@ -12,9 +12,13 @@ use swarm_world::loop_functions::LoopFunctionsParams;
 use swarm_world::loop_functions::obstacle_avoidance::ObstacleAvoidance;
 use swarm_world::{Recorder, World};
 
-/// Runs the thesis example for `ticks` with the obstacle-avoidance rule and returns the trajectory file's bytes.
+/// Runs the thesis example, with proximity noise 0.02 and wheel noise 0.05 so that every random stream is used,
+/// for `ticks` with the obstacle-avoidance rule and returns the trajectory file's bytes.
 fn recorded_run(seed: u64, ticks: u64, dir: &std::path::Path) -> Vec<u8> {
-    let mut world = World::new(&thesis_example(), seed).expect("builds");
+    let mut exp = thesis_example();
+    exp.controllers[0].sensors[0].noise_level = 0.02;
+    exp.controllers[0].actuators[0].noise_std_dev = 0.05;
+    let mut world = World::new(&exp, seed).expect("builds");
     let mut recorder = Recorder::create(dir, &[]).expect("recorder");
     recorder.record_initial(&world).expect("record");
     for _ in 0..ticks {
