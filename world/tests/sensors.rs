@@ -375,3 +375,33 @@ fn pheromone_deposit_is_sensed_with_its_gradient_in_the_robot_frame() {
     let g = frames(&mut world)[0].pheromone_gradient[0];
     assert!(g[0].abs() < 1e-3 && (g[1] - 40.0).abs() < 1e-3, "{g:?}");
 }
+
+#[test]
+fn rab_loss_probability_one_drops_every_message_and_zero_drops_none() {
+    use swarm_world::devices::RabOptions;
+    let run = |loss: f32| {
+        let mut b = builder();
+        let lossy = Devices {
+            rab: Some(RabOptions {
+                data_size: 2,
+                loss_probability: loss,
+            }),
+            ..Devices::ALL
+        };
+        b.robot("a", "c", Vec2::ZERO, 0.0, Devices::ALL);
+        b.robot("b", "c", Vec2::new(0.3, 0.0), 0.0, lossy);
+        let mut world = b.build();
+        let mut cmds = vec![swarm_runtime::messages::ActuatorCommand::idle(0, 1); 2];
+        cmds[0].rab_len = 1;
+        let mut received = 0;
+        for _ in 0..50 {
+            world.act_and_step(&cmds, &[true, true]);
+            received += usize::from(frames(&mut world)[1].rab_len);
+        }
+        received
+    };
+    assert_eq!(run(1.0), 0);
+    assert_eq!(run(0.0), 50);
+    let half = run(0.5);
+    assert!((10..=40).contains(&half), "about half of 50 arrive: {half}");
+}
