@@ -2,8 +2,9 @@
 //! physics, media, loop functions.
 //!
 //! [`WorldBuilder`] assembles a world from explicit entities (tests, benches and the configuration loader all go
-//! through it). A tick touches only preallocated buffers: [`World::sense`] and [`World::act_and_step`] allocate
-//! nothing once the world has run a tick.
+//! through it). A tick touches only preallocated buffers: [`World::sense`] allocates nothing once warmed up, and
+//! [`World::act_and_step`] only reuses buffers around the rapier2d step (which allocates a few small buffers of its
+//! own per step).
 
 use swarm_runtime::config::Experiment;
 use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
@@ -16,7 +17,7 @@ use crate::entities::{
     TargetId, TargetState, floor_grey,
 };
 use crate::error::WorldError;
-use crate::geometry::{Placed, Shape, Vec2};
+use crate::geometry::{Placed, Vec2};
 use crate::loop_functions::{LoopFunctions, LoopFunctionsRegistry, default::DefaultLoopFunctions};
 use crate::media::led::LedMedium;
 use crate::media::pheromone::{ChannelRates, PheromoneField};
@@ -190,22 +191,6 @@ impl WorldBuilder {
     /// Sets the loop functions (the default ones record basic metrics only).
     pub fn loop_functions(&mut self, loop_functions: Box<dyn LoopFunctions>) {
         self.loop_functions = loop_functions;
-    }
-
-    /// The entities placed so far, as outlines (for collision-free placement).
-    pub fn placed_bodies(&self) -> impl Iterator<Item = Placed> + '_ {
-        let robots = self.arena.robots.iter().map(|r| {
-            Placed::new(
-                Shape::Disc {
-                    radius: ROBOT_RADIUS,
-                },
-                r.position,
-                r.heading,
-            )
-        });
-        let obstacles = self.arena.obstacles.iter().map(|o| o.placed);
-        let targets = self.arena.targets.iter().map(|t| t.placed);
-        robots.chain(obstacles).chain(targets)
     }
 
     /// The finished world, with its media indexed for the first tick.

@@ -100,3 +100,15 @@ fn obstacle_avoidance_metrics_count_collisions_per_robot_minute_and_forward_tick
     assert_eq!(m["collisions_per_robot_minute"], 1.0);
     assert_eq!(m["forward_fraction"], 1.0);
 }
+
+#[test]
+fn experiment_length_finishes_the_run_after_its_ticks() {
+    let mut exp = thesis_example();
+    exp.framework.length_seconds = 0.5;
+    let mut world = World::new(&exp, 1).expect("builds");
+    assert_eq!(world.max_ticks(), Some(10), "0.5 s at 20 ticks/s");
+    world.run_in_process(9, avoid_obstacles);
+    assert!(!world.is_finished());
+    world.run_in_process(1, avoid_obstacles);
+    assert!(world.is_finished());
+}
