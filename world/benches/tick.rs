@@ -1,0 +1,117 @@
+//! World cost per robot per tick at ARGoS' obstacle-avoidance density: 50 robots per 16 m^2, N/10 boxes
+//! (0.1 x 0.1 m) and N/10 cylinders (r = 0.1 m) placed uniformly without overlap in a square walled arena,
+//! proximity sensors and wheels only, driven by the in-process obstacle-avoidance rule.
+//!
+//! Groups: `tick` (sense + controller + act/physics/media), `sense` (the proximity rays) and `step`
+//! (actuators, physics and media). Criterion reports elements = robots, so its throughput is robot-ticks/s.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use rand::Rng;
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_world::devices::Devices;
+use swarm_world::geometry::{Placed, Shape, Vec2};
+use swarm_world::in_process::avoid_obstacles;
+use swarm_world::physics::Motion;
+use swarm_world::rng::{Purpose, stream};
+use swarm_world::{World, WorldBuilder};
+
+const SIZES: [usize; 2] = [100, 1000];
+
+/// The ARGoS-density world with `n` robots.
+fn density_world(n: usize) -> World {
+    let side = (n as f32 * 16.0 / 50.0).sqrt();
+    let h = side / 2.0;
+    let mut b = WorldBuilder::new(Vec2::splat(-h - 0.1), Vec2::splat(h + 0.1), 10, 42);
+    let mut occupied: Vec<Placed> = Vec::new();
+    for (i, (pos, size)) in [
+        (Vec2::new(0.0, h + 0.05), Vec2::new(side + 0.2, 0.1)),
+        (Vec2::new(0.0, -h - 0.05), Vec2::new(side + 0.2, 0.1)),
+        (Vec2::new(h + 0.05, 0.0), Vec2::new(0.1, side + 0.2)),
+        (Vec2::new(-h - 0.05, 0.0), Vec2::new(0.1, side + 0.2)),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let wall = Placed::new(Shape::Rect { half: size / 2.0 }, pos, 0.0);
+        b.obstacle(&format!("wall{i}"), wall, 0.5, Motion::Fixed);
+        occupied.push(wall);
+    }
+    let mut rng = stream(42, Purpose::Placement, 0);
+    let mut free = |shape: Shape, rng: &mut rand_chacha::ChaCha8Rng| loop {
+        let p = Vec2::new(rng.random_range(-h..h), rng.random_range(-h..h));
+        let placed = Placed::new(shape, p, rng.random_range(0.0..std::f32::consts::TAU));
+        if !occupied.iter().any(|o| o.overlaps(&placed)) {
+            occupied.push(placed);
+            return placed;
+        }
+    };
+    for i in 0..n / 10 {
+        let bx = free(
+            Shape::Rect {
+                half: Vec2::splat(0.05),
+            },
+            &mut rng,
+        );
+        b.obstacle(&format!("b{i}"), bx, 0.4, Motion::Fixed);
+        let cy = free(Shape::Disc { radius: 0.1 }, &mut rng);
+        b.obstacle(&format!("c{i}"), cy, 0.4, Motion::Fixed);
+    }
+    for i in 0..n {
+        let r = free(Shape::Disc { radius: 0.035 }, &mut rng);
+        b.robot(
+            &format!("fb{i}"),
+            "fdc",
+            r.position,
+            r.angle,
+            Devices::PROXIMITY_ONLY,
+        );
+    }
+    let mut world = b.build();
+    world.run_in_process(50, avoid_obstacles);
+    world
+}
+
+fn bench(c: &mut Criterion) {
+    for &n in &SIZES {
+        let mut world = density_world(n);
+        let mut frames: Vec<SensorFrame> = (0..n as u32).map(SensorFrame::empty).collect();
+        let mut commands: Vec<ActuatorCommand> =
+            (0..n as u32).map(|r| ActuatorCommand::idle(r, 0)).collect();
+        let has = vec![true; n];
+
+        let mut group = c.benchmark_group("tick");
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                world.sense(&mut frames);
+                for (f, cmd) in frames.iter().zip(commands.iter_mut()) {
+                    avoid_obstacles(f, cmd);
+                }
+                world.act_and_step(&commands, &has);
+            })
+        });
+        group.finish();
+
+        let mut group = c.benchmark_group("sense");
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| world.sense(&mut frames))
+        });
+        group.finish();
+
+        let mut group = c.benchmark_group("step");
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                for (f, cmd) in frames.iter().zip(commands.iter_mut()) {
+                    avoid_obstacles(f, cmd);
+                }
+                world.act_and_step(&commands, &has)
+            })
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,148 @@
+//! The e-puck actuators applied to the arena: wheels (differential drive), LEDs, range-and-bearing emitter,
+//! pheromone deposit and the virtual gripper. Applied once per tick, after control and before physics.
+
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use swarm_runtime::messages::{ActuatorCommand, GripperAction, PHEROMONE_CHANNELS};
+
+use crate::arena::{Arena, GripperEvent};
+use crate::entities::{ROBOT_RADIUS, RobotId, TargetId, TargetState};
+use crate::geometry::unit;
+use crate::media::rab::RabMedium;
+
+/// Wheel speed limit in cm/s (the real e-puck's, epuck-and-world.md 1.1).
+pub const MAX_WHEEL_SPEED_CM_S: f32 = 12.8;
+/// Distance between the wheels in metres.
+pub const INTER_WHEEL_DISTANCE: f32 = 0.053;
+/// Default largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm);
+/// the `virtual_gripper` actuator's `pickup_gap` overrides it.
+pub const GRIPPER_REACH: f32 = 0.007;
+/// Gap in metres between the robot's edge and a target it drops in front of itself.
+pub const DROP_GAP: f32 = 0.001;
+
+/// Clamps each wheel to +-12.8 cm/s, then applies the multiplicative Gaussian noise `v <- v + v N(0, sigma)`.
+pub fn wheel_speeds(commanded: [f32; 2], noise_std_dev: f32, rng: &mut ChaCha8Rng) -> [f32; 2] {
+    let mut w = commanded.map(|v| {
+        if v.is_finite() {
+            v.clamp(-MAX_WHEEL_SPEED_CM_S, MAX_WHEEL_SPEED_CM_S)
+        } else {
+            0.0
+        }
+    });
+    if noise_std_dev > 0.0
+        && let Ok(normal) = Normal::new(0.0f32, noise_std_dev)
+    {
+        for v in &mut w {
+            *v += *v * normal.sample(rng);
+        }
+    }
+    w
+}
+
+/// The unicycle velocities of wheel speeds in cm/s: `v = (vl + vr) / 2` in m/s and `w = (vr - vl) / 0.053` in rad/s.
+pub fn unicycle(wheels_cm_s: [f32; 2]) -> (f32, f32) {
+    let (l, r) = (wheels_cm_s[0] / 100.0, wheels_cm_s[1] / 100.0);
+    ((l + r) / 2.0, (r - l) / INTER_WHEEL_DISTANCE)
+}
+
+/// Applies `command` to robot `id`, or holds it still when `command` is `None` (no command, or dead).
+pub fn apply(
+    arena: &mut Arena,
+    rab: &mut RabMedium,
+    id: RobotId,
+    command: Option<&ActuatorCommand>,
+) {
+    let i = id.index();
+    let Some(robot) = arena.robots.get_mut(i) else {
+        return;
+    };
+    let Some(cmd) = command.filter(|_| robot.alive) else {
+        robot.wheels = [0.0; 2];
+        arena.physics.drive(robot.handles.body, 0.0, 0.0);
+        return;
+    };
+    robot.wheels = wheel_speeds(
+        cmd.wheels,
+        robot.devices.wheel_noise_std_dev,
+        &mut robot.rng.wheels,
+    );
+    let (v, w) = unicycle(robot.wheels);
+    arena.physics.drive(robot.handles.body, v, w);
+    robot.led = cmd.led;
+    if let Some(opts) = robot.devices.rab
+        && cmd.rab_len > 0
+    {
+        rab.send(
+            id.0,
+            robot.rab_range,
+            cmd.rab_payload,
+            cmd.rab_len.min(opts.data_size),
+        );
+    }
+    let position = robot.position;
+    for ch in 0..PHEROMONE_CHANNELS {
+        arena
+            .pheromone
+            .deposit(ch, position, cmd.pheromone_deposit[ch]);
+    }
+    match cmd.gripper {
+        GripperAction::Hold => {}
+        GripperAction::Pick => pick(arena, id),
+        GripperAction::Drop => drop_carried(arena, id),
+    }
+}
+
+/// The nearest target lying in the arena within the gripper's reach of robot `id`.
+pub fn target_in_reach(arena: &Arena, id: RobotId) -> Option<TargetId> {
+    let robot = arena.robots.get(id.index())?;
+    arena
+        .targets
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.state == TargetState::InArena)
+        .map(|(i, t)| (i, t.placed.gap_to_disc(robot.position, ROBOT_RADIUS)))
+        .filter(|&(_, gap)| gap <= robot.devices.gripper_reach)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| TargetId(i as u32))
+}
+
+fn pick(arena: &mut Arena, id: RobotId) {
+    if arena.robots[id.index()].carrying.is_some() {
+        return;
+    }
+    let Some(target) = target_in_reach(arena, id) else {
+        return;
+    };
+    let t = &mut arena.targets[target.index()];
+    t.state = TargetState::Carried(id);
+    arena.physics.set_enabled(t.handles, false);
+    arena.robots[id.index()].carrying = Some(target);
+    arena
+        .gripper_events
+        .push(GripperEvent::Picked { robot: id, target });
+}
+
+fn drop_carried(arena: &mut Arena, id: RobotId) {
+    let robot = &arena.robots[id.index()];
+    let Some(target) = robot.carrying else { return };
+    let radius = arena.targets[target.index()].radius();
+    let position = robot.position + unit(robot.heading) * (ROBOT_RADIUS + radius + DROP_GAP);
+    arena.place_target(target, position);
+    arena.gripper_events.push(GripperEvent::Dropped {
+        robot: id,
+        target,
+        position,
+    });
+}
+
+/// After physics: carried targets ride on their robots.
+pub fn carry(arena: &mut Arena) {
+    for t in &mut arena.targets {
+        if let TargetState::Carried(robot) = t.state
+            && let Some(r) = arena.robots.get(robot.index())
+        {
+            t.placed.position = r.position;
+            t.placed.angle = r.heading;
+        }
+    }
+}

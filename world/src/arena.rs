@@ -1,0 +1,111 @@
+//! The arena: the entity sets, the physics that moves them and the pheromone field, plus the operations loop
+//! functions may use on them (ARGoS' `MoveEntity`, `RemoveEntity`, floor colour). This is the state a tick
+//! changes; the order of a tick lives in `world`.
+
+use crate::entities::{
+    FloorRegion, Light, Obstacle, Robot, RobotId, Target, TargetId, TargetState,
+};
+use crate::geometry::Vec2;
+use crate::media::pheromone::PheromoneField;
+use crate::physics::Physics;
+
+/// What the virtual grippers did in the last tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GripperEvent {
+    /// A robot picked a target up.
+    Picked {
+        /// The robot.
+        robot: RobotId,
+        /// The target.
+        target: TargetId,
+    },
+    /// A robot dropped a target at `position`.
+    Dropped {
+        /// The robot.
+        robot: RobotId,
+        /// The target.
+        target: TargetId,
+        /// Where the target now lies.
+        position: Vec2,
+    },
+}
+
+/// The simulated arena.
+pub struct Arena {
+    /// Robots, by [`RobotId`].
+    pub robots: Vec<Robot>,
+    /// Walls, boxes and cylinders.
+    pub obstacles: Vec<Obstacle>,
+    /// Targets.
+    pub targets: Vec<Target>,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// Floor regions, later ones drawn over earlier ones; the floor is white elsewhere.
+    pub floor: Vec<FloorRegion>,
+    /// The pheromone field.
+    pub pheromone: PheromoneField,
+    /// Lower corner of the arena.
+    pub min: Vec2,
+    /// Upper corner of the arena.
+    pub max: Vec2,
+    /// Ticks completed (0 before the first step).
+    pub tick: u64,
+    /// Ticks per simulated second.
+    pub ticks_per_second: u32,
+    /// Gripper events of the last tick.
+    pub gripper_events: Vec<GripperEvent>,
+    pub(crate) physics: Physics,
+}
+
+impl Arena {
+    /// Simulated seconds per tick.
+    pub fn dt(&self) -> f32 {
+        1.0 / self.ticks_per_second as f32
+    }
+
+    /// Grey level of the floor regions at `p` (1 white where no region lies).
+    pub fn floor_grey(&self, p: Vec2) -> f32 {
+        crate::entities::floor_grey(&self.floor, p)
+    }
+
+    /// Takes a target out of the run (for example when it is delivered home); a carrier lets go of it.
+    pub fn remove_target(&mut self, target: TargetId) {
+        let Some(t) = self.targets.get_mut(target.index()) else {
+            return;
+        };
+        if let TargetState::Carried(robot) = t.state
+            && let Some(r) = self.robots.get_mut(robot.index())
+        {
+            r.carrying = None;
+        }
+        t.state = TargetState::Removed;
+        self.physics.set_enabled(t.handles, false);
+    }
+
+    /// Puts a target back into the arena at `position` (out of any gripper).
+    pub fn place_target(&mut self, target: TargetId, position: Vec2) {
+        let Some(t) = self.targets.get_mut(target.index()) else {
+            return;
+        };
+        if let TargetState::Carried(robot) = t.state
+            && let Some(r) = self.robots.get_mut(robot.index())
+        {
+            r.carrying = None;
+        }
+        t.state = TargetState::InArena;
+        t.placed.position = position;
+        self.physics
+            .teleport(t.handles.body, position, t.placed.angle);
+        self.physics.set_enabled(t.handles, true);
+    }
+
+    /// Moves a robot to a new pose and stops it.
+    pub fn move_robot(&mut self, robot: RobotId, position: Vec2, heading: f32) {
+        let Some(r) = self.robots.get_mut(robot.index()) else {
+            return;
+        };
+        r.position = position;
+        r.heading = heading;
+        self.physics.teleport(r.handles.body, position, heading);
+    }
+}

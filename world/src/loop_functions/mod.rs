@@ -1,0 +1,109 @@
+//! Loop functions: the experiment hooks of ARGoS (`PreStep`, `PostStep`, `GetFloorColor`,
+//! `IsExperimentFinished`) plus the task metrics, registered under the label the configuration's
+//! `<loop_functions label="...">` uses. Tasks add their own by registering a factory; the core never changes.
+
+pub mod default;
+pub mod obstacle_avoidance;
+
+use std::collections::BTreeMap;
+
+use swarm_runtime::messages::ActuatorCommand;
+
+use crate::arena::Arena;
+use crate::error::WorldError;
+use crate::geometry::Vec2;
+
+/// The experiment hooks of one task.
+pub trait LoopFunctions: Send {
+    /// Called at the start of every tick's act phase, before the actuators are applied.
+    fn pre_step(&mut self, _arena: &mut Arena) {}
+
+    /// Called at the end of every tick, after physics and media; `commands[i]` is robot i's command of this tick
+    /// when `has_command[i]`.
+    fn post_step(
+        &mut self,
+        _arena: &mut Arena,
+        _commands: &[ActuatorCommand],
+        _has_command: &[bool],
+    ) {
+    }
+
+    /// Grey level of the floor at `p` (1 white, 0 black), or `None` to use the arena's floor regions.
+    fn floor_color(&self, _p: Vec2) -> Option<f32> {
+        None
+    }
+
+    /// Whether the experiment is over (e.g. all targets delivered).
+    fn is_finished(&self, _arena: &Arena) -> bool {
+        false
+    }
+
+    /// The task metrics so far, for `summary.json`.
+    fn metrics(&self, arena: &Arena) -> serde_json::Value;
+}
+
+/// The `<loop_functions>` element as the factories see it.
+#[derive(Debug, Clone, Default)]
+pub struct LoopFunctionsParams {
+    /// The `label` attribute.
+    pub label: String,
+    /// Where the element is (`path:line:column`), for errors.
+    pub location: String,
+    /// Attributes of the element's children, flattened as `child.attribute` -> value
+    /// (e.g. `foraging.home_y_max` -> `-2.0`).
+    pub attributes: BTreeMap<String, String>,
+}
+
+/// Makes the loop functions of one label from the configuration.
+pub type LoopFunctionsFactory =
+    fn(&LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError>;
+
+/// The loop functions known by label.
+#[derive(Debug, Clone)]
+pub struct LoopFunctionsRegistry {
+    factories: BTreeMap<String, LoopFunctionsFactory>,
+}
+
+impl Default for LoopFunctionsRegistry {
+    /// The built-in loop functions: `obstacle_avoidance_loop_functions`.
+    fn default() -> Self {
+        let mut registry = Self {
+            factories: BTreeMap::new(),
+        };
+        registry.register(
+            obstacle_avoidance::LABEL,
+            obstacle_avoidance::ObstacleAvoidance::factory,
+        );
+        registry
+    }
+}
+
+impl LoopFunctionsRegistry {
+    /// Registers (or replaces) the factory for `label`.
+    pub fn register(&mut self, label: &str, factory: LoopFunctionsFactory) {
+        self.factories.insert(label.to_owned(), factory);
+    }
+
+    /// The loop functions for `params`, or the default ones when the configuration has none.
+    pub fn create(
+        &self,
+        params: Option<&LoopFunctionsParams>,
+    ) -> Result<Box<dyn LoopFunctions>, WorldError> {
+        let Some(params) = params else {
+            return Ok(Box::new(default::DefaultLoopFunctions));
+        };
+        match self.factories.get(&params.label) {
+            Some(factory) => factory(params),
+            None => Err(WorldError::UnknownLoopFunctions {
+                location: params.location.clone(),
+                label: params.label.clone(),
+                known: self
+                    .factories
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
+    }
+}

@@ -1,0 +1,200 @@
+//! Rigid-body physics: rapier2d with dynamic robot discs driven by velocity, fixed obstacles, movable objects.
+//!
+//! Robots are dynamic bodies whose velocity is set from the differential-drive model before every step, so the
+//! solver resolves contacts (kinematic bodies would pass through walls). One rapier step per tick with
+//! `dt = 1 / ticks_per_second`, zero gravity (the arena is seen from above). Contacts that start during a step are
+//! collected per robot for the collision metrics. This module knows nothing about sensors or configuration.
+
+use std::sync::Mutex;
+
+use rapier2d::prelude::{
+    ActiveEvents, ColliderBuilder, ColliderHandle, ColliderSet, CollisionEvent, ContactPair,
+    EventHandler, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet,
+    SoftBodyTearEvent,
+};
+
+use crate::geometry::{Shape, Vec2};
+
+/// Mass of an e-puck in kg.
+pub const ROBOT_MASS: f32 = 0.2;
+/// Ground friction of movable objects, as linear and angular damping per second: a pushed object stops soon.
+pub const MOVABLE_DAMPING: f32 = 5.0;
+
+/// Whether a body moves and how.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// Never moves (walls, fixed obstacles, fixed targets).
+    Fixed,
+    /// Pushed by robots; the mass is in kg.
+    Movable {
+        /// Mass in kg.
+        mass: f32,
+    },
+}
+
+/// Collects the robot contacts that start during a step; preallocated so a step does not allocate.
+struct ContactCollector {
+    started: Mutex<Vec<(u128, u128)>>,
+}
+
+impl EventHandler for ContactCollector {
+    fn handle_collision_event(
+        &self,
+        _bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+        event: CollisionEvent,
+        _contact_pair: Option<&ContactPair>,
+    ) {
+        if let CollisionEvent::Started(a, b, _) = event {
+            let tag = |h: ColliderHandle| colliders.get(h).map_or(0, |c| c.user_data);
+            if let Ok(mut started) = self.started.lock() {
+                started.push((tag(a), tag(b)));
+            }
+        }
+    }
+
+    fn handle_contact_force_event(
+        &self,
+        _dt: f32,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        _contact_pair: &ContactPair,
+        _total_force_magnitude: f32,
+    ) {
+    }
+
+    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
+}
+
+/// The physics state of the arena.
+pub struct Physics {
+    world: PhysicsWorld,
+    collector: ContactCollector,
+    started: Vec<(u128, u128)>,
+}
+
+/// Handles of one body in the physics world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BodyHandles {
+    /// The rigid body.
+    pub body: RigidBodyHandle,
+    /// Its one collider.
+    pub collider: ColliderHandle,
+}
+
+impl Physics {
+    /// An empty world stepping `dt` seconds per tick.
+    pub fn new(dt: f32) -> Self {
+        let mut world = PhysicsWorld {
+            gravity: Vec2::ZERO,
+            ..PhysicsWorld::default()
+        };
+        world.integration_parameters.dt = dt;
+        Self {
+            world,
+            collector: ContactCollector {
+                started: Mutex::new(Vec::with_capacity(1024)),
+            },
+            started: Vec::new(),
+        }
+    }
+
+    /// Adds a body of `shape` at `position`/`angle`. `tag` is reported back with the contacts it starts;
+    /// `report_contacts` turns that reporting on (robots).
+    pub fn add(
+        &mut self,
+        shape: Shape,
+        position: Vec2,
+        angle: f32,
+        motion: Motion,
+        tag: u128,
+        report_contacts: bool,
+    ) -> BodyHandles {
+        let builder = match motion {
+            Motion::Fixed => RigidBodyBuilder::fixed(),
+            Motion::Movable { .. } => RigidBodyBuilder::dynamic()
+                .linear_damping(MOVABLE_DAMPING)
+                .angular_damping(MOVABLE_DAMPING),
+        };
+        let body = builder
+            .translation(position)
+            .rotation(angle)
+            .can_sleep(false)
+            .build();
+        let collider = match shape {
+            Shape::Disc { radius } => ColliderBuilder::ball(radius),
+            Shape::Rect { half } => ColliderBuilder::cuboid(half.x, half.y),
+        };
+        let mut collider = collider.friction(0.0).restitution(0.0).user_data(tag);
+        if let Motion::Movable { mass } = motion {
+            collider = collider.mass(mass);
+        }
+        if report_contacts {
+            collider = collider.active_events(ActiveEvents::COLLISION_EVENTS);
+        }
+        let (body, collider) = self.world.insert(body, collider.build());
+        BodyHandles { body, collider }
+    }
+
+    /// Adds an e-puck: a dynamic disc of `radius` whose velocity the world sets every tick.
+    pub fn add_robot(&mut self, radius: f32, position: Vec2, angle: f32, tag: u128) -> BodyHandles {
+        let body = RigidBodyBuilder::dynamic()
+            .translation(position)
+            .rotation(angle)
+            .can_sleep(false)
+            .build();
+        let collider = ColliderBuilder::ball(radius)
+            .mass(ROBOT_MASS)
+            .friction(0.0)
+            .restitution(0.0)
+            .user_data(tag)
+            .active_events(ActiveEvents::COLLISION_EVENTS)
+            .build();
+        let (body, collider) = self.world.insert(body, collider);
+        BodyHandles { body, collider }
+    }
+
+    /// Sets a robot's linear speed along its heading (m/s) and its turn rate (rad/s) for the next step.
+    pub fn drive(&mut self, body: RigidBodyHandle, speed: f32, turn_rate: f32) {
+        if let Some(b) = self.world.bodies.get_mut(body) {
+            let heading = b.rotation().angle();
+            b.set_linvel(crate::geometry::unit(heading) * speed, true);
+            b.set_angvel(turn_rate, true);
+        }
+    }
+
+    /// Enables or disables a body's collider (a carried target leaves the arena).
+    pub fn set_enabled(&mut self, handles: BodyHandles, enabled: bool) {
+        if let Some(c) = self.world.colliders.get_mut(handles.collider) {
+            c.set_enabled(enabled);
+        }
+    }
+
+    /// Moves a body to a new pose and stops it.
+    pub fn teleport(&mut self, body: RigidBodyHandle, position: Vec2, angle: f32) {
+        if let Some(b) = self.world.bodies.get_mut(body) {
+            b.set_translation(position, true);
+            b.set_rotation(rapier2d::math::Rotation::new(angle), true);
+            b.set_linvel(Vec2::ZERO, true);
+            b.set_angvel(0.0, true);
+        }
+    }
+
+    /// Current position and heading of a body.
+    pub fn pose(&self, body: RigidBodyHandle) -> (Vec2, f32) {
+        self.world.bodies.get(body).map_or((Vec2::ZERO, 0.0), |b| {
+            (b.translation(), b.rotation().angle())
+        })
+    }
+
+    /// Advances one tick and returns the pairs of tags whose contact started during it.
+    pub fn step(&mut self) -> &[(u128, u128)] {
+        self.world.step_with_events(&(), &self.collector);
+        self.started.clear();
+        if let Ok(mut started) = self.collector.started.lock() {
+            self.started.extend_from_slice(&started);
+            started.clear();
+        }
+        &self.started
+    }
+}

@@ -1,0 +1,186 @@
+//! PNG snapshots of the arena drawn with tiny-skia, seen from above with +Y up: the floor as the ground sensors see
+//! it (sampled every `FLOOR_SAMPLE` metres), the pheromone heat map, obstacles, targets, lights, and robots in their
+//! LED colours with a heading tick (dead robots dark grey; a red dot marks a carried target).
+
+use std::path::Path;
+
+use swarm_runtime::messages::{PHEROMONE_CHANNELS, Rgb};
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
+
+use crate::arena::Arena;
+use crate::entities::{ROBOT_RADIUS, TargetState};
+use crate::error::WorldError;
+use crate::geometry::{Placed, Shape, Vec2, unit};
+use crate::world::World;
+
+/// Pixels per metre of a snapshot.
+pub const PIXELS_PER_METRE: f32 = 100.0;
+/// Largest snapshot side in pixels; larger arenas are drawn at a lower resolution.
+pub const MAX_SIDE_PX: f32 = 2000.0;
+
+/// Colours of the pheromone channels in the heat map.
+const PHEROMONE_COLOURS: [(u8, u8, u8); PHEROMONE_CHANNELS] = [(220, 60, 20), (30, 90, 220)];
+
+fn paint(r: u8, g: u8, b: u8, a: u8) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color_rgba8(r, g, b, a);
+    p.anti_alias = true;
+    p
+}
+
+/// Side of the floor sampling cells in metres.
+pub const FLOOR_SAMPLE: f32 = 0.05;
+
+/// Draws the world into a PNG file at `path`.
+pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
+    let arena = &world.arena;
+    let err = |message: String| WorldError::Render {
+        path: path.to_path_buf(),
+        message,
+    };
+    let size = arena.max - arena.min;
+    let scale = PIXELS_PER_METRE.min(MAX_SIDE_PX / size.x.max(size.y).max(0.01));
+    let (w, h) = (
+        (size.x * scale).ceil().max(1.0) as u32,
+        (size.y * scale).ceil().max(1.0) as u32,
+    );
+    let mut pixmap =
+        Pixmap::new(w, h).ok_or_else(|| err(format!("cannot allocate a {w} x {h} image")))?;
+    pixmap.fill(Color::WHITE);
+    // World (metres, +Y up) to pixels (+Y down).
+    let tf = Transform::from_row(
+        scale,
+        0.0,
+        0.0,
+        -scale,
+        -arena.min.x * scale,
+        arena.max.y * scale,
+    );
+
+    draw_floor(world, &mut pixmap, tf);
+    draw_pheromone(arena, &mut pixmap, tf);
+    for o in &arena.obstacles {
+        fill_placed(&mut pixmap, &o.placed, &paint(90, 90, 90, 255), tf);
+    }
+    for t in arena
+        .targets
+        .iter()
+        .filter(|t| t.state == TargetState::InArena)
+    {
+        fill_placed(&mut pixmap, &t.placed, &led_paint(t.led, (200, 0, 0)), tf);
+    }
+    for l in &arena.lights {
+        if let Some(path) = PathBuilder::from_circle(l.position.x, l.position.y, 0.05) {
+            pixmap.fill_path(&path, &paint(255, 200, 0, 255), FillRule::Winding, tf, None);
+        }
+    }
+    let outline = Stroke {
+        width: 0.004,
+        ..Stroke::default()
+    };
+    for r in &arena.robots {
+        let body = Placed::new(
+            Shape::Disc {
+                radius: ROBOT_RADIUS,
+            },
+            r.position,
+            r.heading,
+        );
+        let fill = if r.alive {
+            led_paint(r.led, (230, 230, 230))
+        } else {
+            paint(60, 60, 60, 255)
+        };
+        fill_placed(&mut pixmap, &body, &fill, tf);
+        let mut pb = PathBuilder::new();
+        pb.push_circle(r.position.x, r.position.y, ROBOT_RADIUS);
+        let tip = r.position + unit(r.heading) * ROBOT_RADIUS;
+        pb.move_to(r.position.x, r.position.y);
+        pb.line_to(tip.x, tip.y);
+        if let Some(path) = pb.finish() {
+            pixmap.stroke_path(&path, &paint(0, 0, 0, 255), &outline, tf, None);
+        }
+        if r.carrying.is_some()
+            && let Some(path) = PathBuilder::from_circle(r.position.x, r.position.y, 0.012)
+        {
+            pixmap.fill_path(&path, &paint(200, 0, 0, 255), FillRule::Winding, tf, None);
+        }
+    }
+    pixmap.save_png(path).map_err(|e| err(e.to_string()))
+}
+
+fn led_paint(led: Rgb, off: (u8, u8, u8)) -> Paint<'static> {
+    if led.is_on() {
+        paint(led.r, led.g, led.b, 255)
+    } else {
+        paint(off.0, off.1, off.2, 255)
+    }
+}
+
+fn fill_placed(pixmap: &mut Pixmap, placed: &Placed, paint: &Paint, tf: Transform) {
+    let path = match placed.shape {
+        Shape::Disc { radius } => {
+            PathBuilder::from_circle(placed.position.x, placed.position.y, radius)
+        }
+        Shape::Rect { half } => {
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
+                let (s, c) = placed.angle.sin_cos();
+                let local = Vec2::new(sx * half.x, sy * half.y);
+                placed.position + Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y)
+            });
+            let mut pb = PathBuilder::new();
+            pb.move_to(corners[0].x, corners[0].y);
+            for p in &corners[1..] {
+                pb.line_to(p.x, p.y);
+            }
+            pb.close();
+            pb.finish()
+        }
+    };
+    if let Some(path) = path {
+        pixmap.fill_path(&path, paint, FillRule::Winding, tf, None);
+    }
+}
+
+/// Each pheromone cell tinted by its channel colour with opacity growing with concentration (saturating at 1).
+fn draw_pheromone(arena: &Arena, pixmap: &mut Pixmap, tf: Transform) {
+    let (nx, ny, cell) = arena.pheromone.dimensions();
+    for (ch, &(r, g, b)) in PHEROMONE_COLOURS.iter().enumerate() {
+        for y in 0..ny {
+            for x in 0..nx {
+                let v = arena.pheromone.cell_value(ch, x, y);
+                if v <= 0.0 {
+                    continue;
+                }
+                let alpha = (v.min(1.0) * 200.0) as u8;
+                let (x0, y0) = (arena.min.x + x as f32 * cell, arena.min.y + y as f32 * cell);
+                if let Some(rect) = Rect::from_xywh(x0, y0, cell, cell) {
+                    pixmap.fill_rect(rect, &paint(r, g, b, alpha), tf, None);
+                }
+            }
+        }
+    }
+}
+
+/// Every floor sample that is not white, in its grey level.
+fn draw_floor(world: &World, pixmap: &mut Pixmap, tf: Transform) {
+    let (min, max) = (world.arena.min, world.arena.max);
+    let (nx, ny) = (
+        ((max.x - min.x) / FLOOR_SAMPLE).ceil() as usize,
+        ((max.y - min.y) / FLOOR_SAMPLE).ceil() as usize,
+    );
+    for y in 0..ny {
+        for x in 0..nx {
+            let corner = min + Vec2::new(x as f32, y as f32) * FLOOR_SAMPLE;
+            let grey = world
+                .floor_at(corner + Vec2::splat(FLOOR_SAMPLE / 2.0))
+                .clamp(0.0, 1.0);
+            if grey < 1.0
+                && let Some(rect) = Rect::from_xywh(corner.x, corner.y, FLOOR_SAMPLE, FLOOR_SAMPLE)
+            {
+                let g = (grey * 255.0) as u8;
+                pixmap.fill_rect(rect, &paint(g, g, g, 255), tf, None);
+            }
+        }
+    }
+}

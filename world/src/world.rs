@@ -1,0 +1,469 @@
+//! The world and its tick, in ARGoS order: sense (every robot's frame), control (outside, in the agents), act,
+//! physics, media, loop functions.
+//!
+//! [`WorldBuilder`] assembles a world from explicit entities (tests, benches and the configuration loader all go
+//! through it). A tick touches only preallocated buffers: [`World::sense`] allocates nothing once warmed up, and
+//! [`World::act_and_step`] only reuses buffers around the rapier2d step (which allocates a few small buffers of its
+//! own per step).
+
+use swarm_runtime::config::Experiment;
+use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
+
+use crate::actuators;
+use crate::arena::Arena;
+use crate::devices::Devices;
+use crate::entities::{
+    FloorRegion, Light, LightId, Obstacle, ObstacleId, ROBOT_RADIUS, Robot, RobotId, Target,
+    TargetId, TargetState, floor_grey,
+};
+use crate::error::WorldError;
+use crate::geometry::{Placed, Vec2};
+use crate::loop_functions::{LoopFunctions, LoopFunctionsRegistry, default::DefaultLoopFunctions};
+use crate::media::led::LedMedium;
+use crate::media::pheromone::{ChannelRates, PheromoneField};
+use crate::media::rab::RabMedium;
+use crate::physics::{Motion, Physics};
+use crate::rng::RobotStreams;
+use crate::scene::Scene;
+use crate::sensors::{Observer, camera, ground, light, proximity, rab};
+
+/// Default range of a robot's range-and-bearing emitter in metres.
+pub const DEFAULT_RAB_RANGE: f32 = 0.8;
+/// Default pheromone cell side in metres (tasks.md 5.2).
+pub const DEFAULT_PHEROMONE_CELL: f32 = 0.05;
+
+/// Tags in physics user data: the kind in the high word, the index in the low word.
+const TAG_ROBOT: u128 = 1 << 32;
+const TAG_OBSTACLE: u128 = 2 << 32;
+const TAG_TARGET: u128 = 3 << 32;
+
+/// Assembles a [`World`] from explicit entities.
+pub struct WorldBuilder {
+    arena: Arena,
+    seed: u64,
+    loop_functions: Box<dyn LoopFunctions>,
+}
+
+impl WorldBuilder {
+    /// An empty arena `min..max` stepping `ticks_per_second` times per simulated second, for the run `seed`.
+    pub fn new(min: Vec2, max: Vec2, ticks_per_second: u32, seed: u64) -> Self {
+        let ticks_per_second = ticks_per_second.max(1);
+        let no_decay = [ChannelRates {
+            evaporation: 0.0,
+            diffusion: 0.0,
+        }; PHEROMONE_CHANNELS];
+        Self {
+            arena: Arena {
+                robots: Vec::new(),
+                obstacles: Vec::new(),
+                targets: Vec::new(),
+                lights: Vec::new(),
+                floor: Vec::new(),
+                pheromone: PheromoneField::new(min, max, DEFAULT_PHEROMONE_CELL, no_decay),
+                min,
+                max,
+                tick: 0,
+                ticks_per_second,
+                gripper_events: Vec::new(),
+                physics: Physics::new(1.0 / ticks_per_second as f32),
+            },
+            seed,
+            loop_functions: Box::new(DefaultLoopFunctions),
+        }
+    }
+
+    /// Adds an e-puck at `position` facing `heading` radians.
+    pub fn robot(
+        &mut self,
+        name: &str,
+        controller: &str,
+        position: Vec2,
+        heading: f32,
+        devices: Devices,
+    ) -> RobotId {
+        let id = RobotId(self.arena.robots.len() as u32);
+        let handles = self.arena.physics.add_robot(
+            ROBOT_RADIUS,
+            position,
+            heading,
+            TAG_ROBOT | u128::from(id.0),
+        );
+        self.arena.robots.push(Robot {
+            name: name.to_owned(),
+            controller: controller.to_owned(),
+            handles,
+            position,
+            heading,
+            led: swarm_runtime::messages::Rgb::OFF,
+            alive: true,
+            wheels: [0.0; 2],
+            carrying: None,
+            collisions: 0,
+            rab_range: DEFAULT_RAB_RANGE,
+            devices,
+            rng: RobotStreams::new(self.seed, id.0),
+        });
+        id
+    }
+
+    /// Sets a robot's range-and-bearing emitter range in metres.
+    pub fn rab_range(&mut self, robot: RobotId, range: f32) {
+        if let Some(r) = self.arena.robots.get_mut(robot.index()) {
+            r.rab_range = range;
+        }
+    }
+
+    /// Adds a wall, box or cylinder.
+    pub fn obstacle(
+        &mut self,
+        name: &str,
+        placed: Placed,
+        height: f32,
+        motion: Motion,
+    ) -> ObstacleId {
+        let id = ObstacleId(self.arena.obstacles.len() as u32);
+        let tag = TAG_OBSTACLE | u128::from(id.0);
+        let handles = self.arena.physics.add(
+            placed.shape,
+            placed.position,
+            placed.angle,
+            motion,
+            tag,
+            false,
+        );
+        self.arena.obstacles.push(Obstacle {
+            name: name.to_owned(),
+            placed,
+            height,
+            motion,
+            handles,
+        });
+        id
+    }
+
+    /// Adds a target: a fixed passive body with an LED at `led_height`.
+    pub fn target(
+        &mut self,
+        name: &str,
+        placed: Placed,
+        height: f32,
+        led: swarm_runtime::messages::Rgb,
+        led_height: f32,
+    ) -> TargetId {
+        let id = TargetId(self.arena.targets.len() as u32);
+        let tag = TAG_TARGET | u128::from(id.0);
+        let handles = self.arena.physics.add(
+            placed.shape,
+            placed.position,
+            placed.angle,
+            Motion::Fixed,
+            tag,
+            false,
+        );
+        self.arena.targets.push(Target {
+            name: name.to_owned(),
+            placed,
+            height,
+            led,
+            led_height,
+            state: TargetState::InArena,
+            handles,
+        });
+        id
+    }
+
+    /// Adds a light source.
+    pub fn light(&mut self, light: Light) -> LightId {
+        self.arena.lights.push(light);
+        LightId(self.arena.lights.len() as u32 - 1)
+    }
+
+    /// Adds a floor region (drawn over earlier ones).
+    pub fn floor_region(&mut self, region: FloorRegion) {
+        self.arena.floor.push(region);
+    }
+
+    /// Replaces the pheromone field with one of `cell`-metre cells and the given per-channel rates.
+    pub fn pheromone(&mut self, cell: f32, rates: [ChannelRates; PHEROMONE_CHANNELS]) {
+        self.arena.pheromone = PheromoneField::new(self.arena.min, self.arena.max, cell, rates);
+    }
+
+    /// Sets the loop functions (the default ones record basic metrics only).
+    pub fn loop_functions(&mut self, loop_functions: Box<dyn LoopFunctions>) {
+        self.loop_functions = loop_functions;
+    }
+
+    /// The finished world, with its media indexed for the first tick.
+    pub fn build(self) -> World {
+        let (min, max) = (self.arena.min, self.arena.max);
+        let mut world = World {
+            scene: Scene::new(min, max),
+            leds: LedMedium::new(min, max, camera::CAMERA_RANGE),
+            rab: RabMedium::new(min, max, DEFAULT_RAB_RANGE),
+            arena: self.arena,
+            loop_functions: self.loop_functions,
+            scratch: Vec::with_capacity(64),
+            max_ticks: None,
+        };
+        world.update_media();
+        world
+    }
+}
+
+/// A running world.
+pub struct World {
+    /// The arena state.
+    pub arena: Arena,
+    scene: Scene,
+    leds: LedMedium,
+    rab: RabMedium,
+    loop_functions: Box<dyn LoopFunctions>,
+    scratch: Vec<u32>,
+    max_ticks: Option<u64>,
+}
+
+impl World {
+    /// Builds the world of a parsed experiment for the run `seed`, with the built-in loop functions.
+    pub fn new(experiment: &Experiment, seed: u64) -> Result<World, WorldError> {
+        Self::with_registry(experiment, seed, &LoopFunctionsRegistry::default())
+    }
+
+    /// Builds the world of a parsed experiment for the run `seed`, with loop functions from `registry`.
+    pub fn with_registry(
+        experiment: &Experiment,
+        seed: u64,
+        registry: &LoopFunctionsRegistry,
+    ) -> Result<World, WorldError> {
+        crate::from_config::build(experiment, seed, registry)
+    }
+
+    /// Number of robots.
+    pub fn robot_count(&self) -> usize {
+        self.arena.robots.len()
+    }
+
+    /// Ticks completed.
+    pub fn tick(&self) -> u64 {
+        self.arena.tick
+    }
+
+    /// Stops the experiment after `ticks` ticks (`None`: only the loop functions stop it).
+    pub fn set_max_ticks(&mut self, ticks: Option<u64>) {
+        self.max_ticks = ticks;
+    }
+
+    /// The tick limit (`None`: only the loop functions stop the experiment).
+    pub fn max_ticks(&self) -> Option<u64> {
+        self.max_ticks
+    }
+
+    /// Whether the experiment is over: the tick limit is reached or the loop functions say so.
+    pub fn is_finished(&self) -> bool {
+        self.max_ticks.is_some_and(|m| self.arena.tick >= m)
+            || self.loop_functions.is_finished(&self.arena)
+    }
+
+    /// The task metrics of the loop functions.
+    pub fn metrics(&self) -> serde_json::Value {
+        self.loop_functions.metrics(&self.arena)
+    }
+
+    /// Grey level of the floor at `p` as the ground sensors read it (loop functions first, then floor regions).
+    pub fn floor_at(&self, p: Vec2) -> f32 {
+        self.loop_functions
+            .floor_color(p)
+            .unwrap_or_else(|| floor_grey(&self.arena.floor, p))
+    }
+
+    /// Marks a robot alive or dead. A dead robot stays as an inert obstacle with its LED off and never acts.
+    pub fn set_alive(&mut self, robot: RobotId, alive: bool) {
+        let Some(r) = self.arena.robots.get_mut(robot.index()) else {
+            return;
+        };
+        r.alive = alive;
+        if !alive {
+            r.led = swarm_runtime::messages::Rgb::OFF;
+            r.wheels = [0.0; 2];
+            self.arena.physics.drive(r.handles.body, 0.0, 0.0);
+        }
+        self.leds
+            .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+    }
+
+    /// Fills every robot's frame for the coming tick (`frames[i]` for robot i; extra frames are left alone).
+    pub fn sense(&mut self, frames: &mut [SensorFrame]) {
+        let tick = self.arena.tick + 1;
+        let arena = &mut self.arena;
+        let floor = |p: Vec2| {
+            self.loop_functions
+                .floor_color(p)
+                .unwrap_or_else(|| floor_grey(&arena.floor, p))
+        };
+        for (i, (robot, frame)) in arena.robots.iter_mut().zip(frames.iter_mut()).enumerate() {
+            let me = i as u32;
+            if !robot.alive {
+                // A dead robot senses nothing; its frame only says so.
+                *frame = SensorFrame::empty(me);
+                frame.alive = 0;
+            }
+            frame.tick = tick;
+            frame.robot = me;
+            frame.gripper_holding = u8::from(robot.carrying.is_some());
+            frame.position = [robot.position.x, robot.position.y];
+            frame.heading = robot.heading;
+            if !robot.alive {
+                continue;
+            }
+            frame.alive = 1;
+            frame.camera_len = 0;
+            frame.rab_len = 0;
+            let (pos, heading) = (robot.position, robot.heading);
+            let observer = Observer {
+                me,
+                position: pos,
+                heading,
+            };
+            let devices = robot.devices;
+            if let Some(opts) = &devices.proximity {
+                proximity::sense(
+                    &self.scene,
+                    observer,
+                    opts,
+                    &mut robot.rng.proximity,
+                    &mut self.scratch,
+                    &mut frame.proximity,
+                );
+            }
+            if let Some(level) = devices.light {
+                light::sense(
+                    &self.scene,
+                    &arena.lights,
+                    observer,
+                    level,
+                    &mut robot.rng.light,
+                    &mut frame.light,
+                );
+            }
+            if let Some(level) = devices.ground {
+                ground::sense(
+                    pos,
+                    heading,
+                    floor,
+                    level,
+                    &mut robot.rng.ground,
+                    &mut frame.ground,
+                );
+            }
+            if let Some(opts) = &devices.camera {
+                camera::sense(
+                    &self.scene,
+                    &self.leds,
+                    observer,
+                    opts,
+                    &mut robot.rng.camera,
+                    frame,
+                );
+            }
+            if let Some(opts) = &devices.rab {
+                rab::sense(
+                    &self.scene,
+                    &self.rab,
+                    observer,
+                    opts,
+                    &mut robot.rng.rab,
+                    frame,
+                );
+            }
+            let (s, c) = heading.sin_cos();
+            for ch in 0..PHEROMONE_CHANNELS {
+                frame.pheromone[ch] = arena.pheromone.concentration(ch, pos);
+                let g = arena.pheromone.gradient(ch, pos);
+                frame.pheromone_gradient[ch] = [c * g.x + s * g.y, -s * g.x + c * g.y];
+            }
+        }
+    }
+
+    /// Applies this tick's commands (robots without one, and dead robots, hold still), then steps physics, media
+    /// and the loop functions. `commands[i]` and `has_command[i]` belong to robot i.
+    pub fn act_and_step(&mut self, commands: &[ActuatorCommand], has_command: &[bool]) {
+        self.arena.tick += 1;
+        self.arena.gripper_events.clear();
+        self.loop_functions.pre_step(&mut self.arena);
+        self.rab.clear();
+        for i in 0..self.arena.robots.len() {
+            let cmd = commands
+                .get(i)
+                .filter(|_| has_command.get(i).copied().unwrap_or(false));
+            actuators::apply(&mut self.arena, &mut self.rab, RobotId(i as u32), cmd);
+        }
+        self.step_physics();
+        self.update_media();
+        self.loop_functions
+            .post_step(&mut self.arena, commands, has_command);
+    }
+
+    fn step_physics(&mut self) {
+        let arena = &mut self.arena;
+        for &(a, b) in arena.physics.step() {
+            for tag in [a, b] {
+                if tag >> 32 == TAG_ROBOT >> 32
+                    && let Some(r) = arena.robots.get_mut((tag & 0xffff_ffff) as usize)
+                {
+                    r.collisions += 1;
+                }
+            }
+        }
+        for r in &mut arena.robots {
+            (r.position, r.heading) = arena.physics.pose(r.handles.body);
+        }
+        for o in arena
+            .obstacles
+            .iter_mut()
+            .filter(|o| matches!(o.motion, Motion::Movable { .. }))
+        {
+            (o.placed.position, o.placed.angle) = arena.physics.pose(o.handles.body);
+        }
+        actuators::carry(arena);
+    }
+
+    fn update_media(&mut self) {
+        self.scene.rebuild(
+            &self.arena.robots,
+            &self.arena.obstacles,
+            &self.arena.targets,
+        );
+        self.leds
+            .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+        self.rab.commit(&self.arena.robots);
+        self.arena.pheromone.step();
+    }
+
+    /// Runs `ticks` ticks with an in-process controller called once per live robot per tick (tests and benches).
+    /// Each robot's command persists between ticks, like a real actuator's last setting.
+    pub fn run_in_process(
+        &mut self,
+        ticks: u64,
+        mut controller: impl FnMut(&SensorFrame, &mut ActuatorCommand),
+    ) {
+        let n = self.robot_count();
+        let mut frames: Vec<SensorFrame> = (0..n as u32).map(SensorFrame::empty).collect();
+        let mut commands: Vec<ActuatorCommand> =
+            (0..n as u32).map(|r| ActuatorCommand::idle(r, 0)).collect();
+        let mut has_command = vec![false; n];
+        for _ in 0..ticks {
+            self.sense(&mut frames);
+            for ((frame, cmd), has) in frames
+                .iter()
+                .zip(commands.iter_mut())
+                .zip(has_command.iter_mut())
+            {
+                *has = frame.alive != 0;
+                if *has {
+                    cmd.tick = frame.tick;
+                    controller(frame, cmd);
+                }
+            }
+            self.act_and_step(&commands, &has_command);
+        }
+    }
+}

@@ -1,0 +1,89 @@
+//! The shipped `.argos` files, parsed by the runtime's parser, build into worlds as the tasks describe them.
+
+use std::path::PathBuf;
+
+use swarm_runtime::config::Experiment;
+use swarm_runtime::messages::SensorFrame;
+use swarm_world::entities::TargetState;
+use swarm_world::loop_functions::default::DefaultLoopFunctions;
+use swarm_world::loop_functions::{LoopFunctions, LoopFunctionsParams};
+use swarm_world::{LoopFunctionsRegistry, World, WorldError};
+
+fn load(relative: &str) -> Experiment {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative);
+    match Experiment::load(&path) {
+        Ok((exp, _warnings)) => exp,
+        Err(e) => panic!("{relative} does not load: {e}"),
+    }
+}
+
+#[test]
+fn thesis_example_file_builds_with_robots_in_the_shared_canonical_order() {
+    let exp = load("configs/obstacle_avoidance/thesis_example.argos");
+    let world = World::new(&exp, 124).expect("builds");
+    assert_eq!(world.robot_count(), 40);
+    assert_eq!(
+        world.arena.obstacles.len(),
+        24,
+        "4 walls, 10 boxes, 10 cylinders"
+    );
+    let canonical: Vec<String> = exp.arena.robots().into_iter().map(|r| r.id).collect();
+    let ours: Vec<String> = world.arena.robots.iter().map(|r| r.name.clone()).collect();
+    assert_eq!(ours, canonical);
+    assert_eq!(world.arena.ticks_per_second, 20);
+}
+
+#[test]
+fn density_file_with_1000_robots_builds() {
+    let exp = load("configs/obstacle_avoidance/density_N1000.argos");
+    let world = World::new(&exp, 1).expect("builds");
+    assert_eq!(world.robot_count(), 1000);
+    assert_eq!(world.arena.obstacles.len(), 4 + 200);
+}
+
+fn foraging_registry() -> LoopFunctionsRegistry {
+    // The foraging task registers its own loop functions; here any factory under the label will do.
+    fn factory(_: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
+        Ok(Box::new(DefaultLoopFunctions))
+    }
+    let mut registry = LoopFunctionsRegistry::default();
+    registry.register("foraging_loop_functions", factory);
+    registry
+}
+
+#[test]
+fn foraging_file_starts_robots_on_the_black_home_strip_with_the_lights_in_view() {
+    let exp = load("configs/foraging/foraging.argos");
+    assert!(matches!(
+        World::new(&exp, 1),
+        Err(WorldError::UnknownLoopFunctions { .. })
+    ));
+    let mut world = World::with_registry(&exp, 1, &foraging_registry()).expect("builds");
+    assert_eq!(world.robot_count(), 40);
+    assert_eq!(world.arena.targets.len(), 40);
+    assert!(
+        world
+            .arena
+            .targets
+            .iter()
+            .all(|t| t.state == TargetState::InArena && t.placed.position.y >= -1.9)
+    );
+    assert_eq!(world.arena.lights.len(), 4);
+    assert_eq!(world.arena.obstacles.len(), 4 + 20);
+    assert_eq!(world.max_ticks(), Some(144_000));
+    let mut frames: Vec<SensorFrame> = (0..40).map(SensorFrame::empty).collect();
+    world.sense(&mut frames);
+    for f in &frames {
+        assert!(
+            f.ground.iter().all(|&g| g <= 0.02),
+            "home is black, noise E = 0.02: {:?}",
+            f.ground
+        );
+        assert!(
+            f.light.iter().any(|&l| l > 0.0),
+            "every robot in home senses a home light"
+        );
+    }
+}
