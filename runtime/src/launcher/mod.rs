@@ -224,13 +224,13 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
 
     wait_ready(&mut children, &reports, robots)?;
     children.agents.reserve(roster.len());
-    for (robot, entry) in roster.iter().enumerate() {
+    for robot in 0..roster.len() {
         let agent_args = AgentArgs {
             run: run_args.clone(),
             robot: robot as u32,
             config: config.clone(),
-            controller: entry.epuck.controller.clone(),
             seed,
+            robots: options.robots,
         };
         let log_path = run_dir::agent_log(&out_dir, robot as u32);
         let log = std::fs::File::create(&log_path).map_err(io(format!("creating {}", log_path.display())))?;

@@ -16,7 +16,7 @@ pub struct RunArgs {
     #[arg(long = "run")]
     pub run: String,
     /// Absolute iceoryx2 root directory of the run.
-    #[arg(long = "iox-root")]
+    #[arg(long = "root")]
     pub iox_root: PathBuf,
 }
 
@@ -26,7 +26,7 @@ impl RunArgs {
         vec![
             "--run".into(),
             self.run.clone(),
-            "--iox-root".into(),
+            "--root".into(),
             self.iox_root.display().to_string(),
         ]
     }
@@ -96,15 +96,15 @@ pub struct AgentArgs {
     /// Index of the robot in the run (0..N).
     #[arg(long)]
     pub robot: u32,
-    /// The experiment configuration (the controller's parameters and supervisors come from it).
+    /// The experiment configuration; the robot runs the controller its `<e-puck>` names.
     #[arg(long)]
     pub config: PathBuf,
-    /// Id of the robot's controller in the configuration's `<controllers>`.
-    #[arg(long)]
-    pub controller: String,
     /// Run seed; the robot's random stream is derived from it and the robot index.
     #[arg(long)]
     pub seed: u64,
+    /// Number of robots of the run, when `swarm run --robots` changed the configuration's count.
+    #[arg(long)]
+    pub robots: Option<u32>,
 }
 
 impl AgentArgs {
@@ -116,11 +116,12 @@ impl AgentArgs {
             self.robot.to_string(),
             "--config".into(),
             self.config.display().to_string(),
-            "--controller".into(),
-            self.controller.clone(),
             "--seed".into(),
             self.seed.to_string(),
         ]);
+        if let Some(robots) = self.robots {
+            args.extend(["--robots".into(), robots.to_string()]);
+        }
         args
     }
 }
@@ -172,8 +173,8 @@ mod tests {
             run: run(),
             robot: 7,
             config: PathBuf::from("configs/x.argos"),
-            controller: "fdc".into(),
             seed: 124,
+            robots: Some(40),
         };
         let line = std::iter::once("robot-agent".to_string()).chain(args.to_args());
         assert_eq!(Agent::parse_from(line).args, args);

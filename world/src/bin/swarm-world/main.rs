@@ -24,6 +24,7 @@ use swarm_runtime::launcher::world_report::WorldReport;
 use swarm_runtime::messages::ActuatorCommand;
 use swarm_runtime::transport::{DeathNotices, LinkConfig, RunSpec, WorldLink};
 use swarm_world::World;
+use swarm_world::entities::RobotId;
 use swarm_world::recorder::Recorder;
 
 use events::EventsWriter;
@@ -131,7 +132,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         for robot in deaths.try_iter() {
             if let Some(flag) = dead.get_mut(robot as usize) {
                 *flag = true;
-                world.set_alive(world.robot_id(robot as usize), false);
+                world.set_alive(RobotId(robot), false);
             }
         }
         let tick_started = Instant::now();
