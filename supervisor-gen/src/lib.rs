@@ -6,3 +6,10 @@
 //! `shared/reference/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
 //!
 //! This crate depends on nothing else of the workspace.
+
+pub mod diagnostics;
+mod nadzoru;
+pub mod source;
+pub mod validate;
+pub mod xml_read;
+mod xml_tree;
