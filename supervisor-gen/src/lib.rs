@@ -7,6 +7,7 @@
 //!
 //! This crate depends on nothing else of the workspace.
 
+pub mod automaton;
 pub mod diagnostics;
 mod nadzoru;
 pub mod source;
