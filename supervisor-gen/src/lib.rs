@@ -8,9 +8,13 @@
 //! This crate depends on nothing else of the workspace.
 
 pub mod automaton;
+pub mod convert;
 pub mod diagnostics;
+pub mod dot;
+pub mod load;
 mod nadzoru;
 pub mod source;
 pub mod validate;
 pub mod xml_read;
+pub mod xml_write;
 mod xml_tree;

@@ -9,9 +9,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::diagnostics::{Code, Diagnostic, Position};
-use crate::source::{
-    EventDecl, Located, ModelKind, SourceFormat, SourceModel, StateDecl, TransitionDecl,
-};
+use crate::automaton::ModelKind;
+use crate::source::{EventDecl, Located, SourceFormat, SourceModel, StateDecl, TransitionDecl};
 use crate::xml_read::Shape;
 use crate::xml_tree::Element;
 

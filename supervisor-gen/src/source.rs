@@ -4,10 +4,7 @@
 //! Both readers (the thesis format in `xml_read` and the Nadzoru2 importer in `nadzoru`) produce a [`SourceModel`];
 //! `validate` checks it and turns it into typed models. Nothing here interprets weights, times or reachability.
 
-use std::fmt;
-
-use serde::Serialize;
-
+use crate::automaton::ModelKind;
 use crate::diagnostics::Position;
 
 /// A value together with where it was written.
@@ -19,43 +16,14 @@ pub struct Located<T> {
     pub at: Position,
 }
 
-/// The role of a model in a project.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ModelKind {
-    /// A free-behaviour model G (what the robot can do).
-    Plant,
-    /// A control specification E (what the robot should do).
-    Spec,
-    /// A synthesised supervisor (tool output, accepted back as input by `check` and `draw`).
-    Supervisor,
-}
-
-impl ModelKind {
-    /// Parses the `automata/@type` value: `plant`, `spec`, `supervisor` and the long forms `free-behaviour` and
-    /// `specification`.
-    pub fn parse(value: &str) -> Option<ModelKind> {
-        match value {
-            "plant" | "free-behaviour" => Some(ModelKind::Plant),
-            "spec" | "specification" => Some(ModelKind::Spec),
-            "supervisor" => Some(ModelKind::Supervisor),
-            _ => None,
-        }
-    }
-
-    /// The canonical short form written to files.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            ModelKind::Plant => "plant",
-            ModelKind::Spec => "spec",
-            ModelKind::Supervisor => "supervisor",
-        }
-    }
-}
-
-impl fmt::Display for ModelKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
+/// Parses the `automata/@type` value: `plant`, `spec`, `supervisor` and the long forms `free-behaviour` and
+/// `specification`.
+pub fn parse_kind(value: &str) -> Option<ModelKind> {
+    match value {
+        "plant" | "free-behaviour" => Some(ModelKind::Plant),
+        "spec" | "specification" => Some(ModelKind::Spec),
+        "supervisor" => Some(ModelKind::Supervisor),
+        _ => None,
     }
 }
 

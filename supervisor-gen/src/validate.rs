@@ -1,5 +1,6 @@
 //! Structural validation of ptsct.md section 11: the per-file rules V1-V9, V11, V12, V14, V15 and W1-W4, and the
-//! project rules V10, V13, V15 (event count), W5 and W6.
+//! project rules V10, V13, V15 (event count), W5 and W6. Supervisor files (tool output read back) are exempt from
+//! V6 and V7.
 //!
 //! Every problem of every file is reported in one pass; nothing here stops early. A project with any error yields no
 //! models, so it can never reach synthesis. This module never reads files and never prints.
@@ -7,7 +8,8 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
-use crate::source::{Located, ModelKind, SourceFormat, SourceModel};
+use crate::automaton::ModelKind;
+use crate::source::{Located, SourceFormat, SourceModel, parse_kind};
 
 /// Limits of the compiled byte layout (section 9) that input models are checked against (V15).
 pub mod limits {
@@ -116,7 +118,7 @@ fn declared_kind(source: &SourceModel) -> Option<ModelKind> {
     source
         .kind
         .as_ref()
-        .and_then(|k| ModelKind::parse(&k.value))
+        .and_then(|k| parse_kind(&k.value))
 }
 
 /// Per-file rules. Returns the typed model when the file could be resolved (errors may still have been reported).
@@ -144,7 +146,7 @@ fn check_file(
             report(Code::V13, source.root, message);
             None
         }
-        Some(k) => match ModelKind::parse(&k.value) {
+        Some(k) => match parse_kind(&k.value) {
             None => {
                 report(
                     Code::V13,
@@ -398,9 +400,11 @@ fn check_file(
         });
     }
 
-    // V6, V7.
+    // V6, V7. A supervisor's alphabet is meaningful even for events it never enables (they stay disabled at
+    // runtime), so tool output is exempt.
+    let is_supervisor = kind == Some(ModelKind::Supervisor);
     for (s, used) in used_states.iter().enumerate() {
-        if !used {
+        if !used && !is_supervisor {
             report(
                 Code::V6,
                 state_at[s],
@@ -409,7 +413,7 @@ fn check_file(
         }
     }
     for (e, used) in used_events.iter().enumerate() {
-        if !used {
+        if !used && !is_supervisor {
             report(
                 Code::V7,
                 event_at[e],

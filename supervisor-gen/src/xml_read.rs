@@ -6,9 +6,8 @@
 
 use crate::diagnostics::{Code, Diagnostic, Position};
 use crate::nadzoru;
-use crate::source::{
-    EventDecl, Located, ModelKind, SourceFormat, SourceModel, StateDecl, TransitionDecl,
-};
+use crate::automaton::ModelKind;
+use crate::source::{EventDecl, Located, SourceFormat, SourceModel, StateDecl, TransitionDecl};
 use crate::xml_tree::{self, Element};
 
 /// Reads one model file. `file` is the name used in diagnostics; `role` is how the user passed it (`--plant`,
