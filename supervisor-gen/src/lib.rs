@@ -9,6 +9,7 @@
 
 pub mod architecture;
 pub mod automaton;
+pub mod codegen;
 pub mod compiled;
 pub mod minimise;
 pub mod normalise;
