@@ -7,14 +7,23 @@
 //!
 //! This crate depends on nothing else of the workspace.
 
+pub mod architecture;
 pub mod automaton;
+pub mod codegen;
+pub mod compiled;
 pub mod convert;
 pub mod diagnostics;
 pub mod dot;
 pub mod load;
+pub mod minimise;
 mod nadzoru;
+pub mod normalise;
+pub mod pipeline;
+pub mod product;
 pub mod source;
+pub mod supc;
+pub mod trim;
 pub mod validate;
 pub mod xml_read;
-pub mod xml_write;
 mod xml_tree;
+pub mod xml_write;
