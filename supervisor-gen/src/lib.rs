@@ -6,3 +6,24 @@
 //! `shared/reference/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
 //!
 //! This crate depends on nothing else of the workspace.
+
+pub mod architecture;
+pub mod automaton;
+pub mod codegen;
+pub mod compiled;
+pub mod convert;
+pub mod diagnostics;
+pub mod dot;
+pub mod load;
+pub mod minimise;
+mod nadzoru;
+pub mod normalise;
+pub mod pipeline;
+pub mod product;
+pub mod source;
+pub mod supc;
+pub mod trim;
+pub mod validate;
+pub mod xml_read;
+mod xml_tree;
+pub mod xml_write;

@@ -1,0 +1,307 @@
+//! The n-ary synchronous product of ptSCT generators (section 4), accessible part only (C2).
+//!
+//! States are tuples of component states, stored flat and indexed by an open-addressing hash table that exists
+//! only during construction. Shared controllable events multiply P and take the maximum T; private events keep
+//! their component's labels; uncontrollable transitions carry P = 1 and T = 0. Plant factors are whatever the
+//! caller's normalisation left in them (1 under rule A5). The product of an empty list is the identity (C3).
+
+use crate::automaton::{Automaton, EventId, EventTable, ModelKind, StateId, Transition};
+
+/// A product together with the component-state tuple of each of its states.
+#[derive(Debug, Clone)]
+pub struct ProductOutput {
+    /// The accessible product.
+    pub automaton: Automaton,
+    /// Number of components (tuple length).
+    pub arity: usize,
+    /// Flat tuples: state `x` is `tuples[x * arity .. (x + 1) * arity]`.
+    pub tuples: Vec<u32>,
+}
+
+impl ProductOutput {
+    /// The component-state tuple of product state `x`.
+    pub fn tuple(&self, x: StateId) -> &[u32] {
+        &self.tuples[x.index() * self.arity..(x.index() + 1) * self.arity]
+    }
+}
+
+/// The accessible synchronous product `parts[0] ∥ … ∥ parts[n-1]`, named `name` and of kind `kind`.
+pub fn product(
+    name: &str,
+    kind: ModelKind,
+    events: &EventTable,
+    parts: &[&Automaton],
+) -> Automaton {
+    product_with_tuples(name, kind, events, parts).automaton
+}
+
+/// Like [`product`], also returning each product state's component tuple (used to find g(x) in SupC).
+pub fn product_with_tuples(
+    name: &str,
+    kind: ModelKind,
+    events: &EventTable,
+    parts: &[&Automaton],
+) -> ProductOutput {
+    let arity = parts.len();
+    if arity == 0 {
+        return ProductOutput {
+            automaton: Automaton::identity(name, kind),
+            arity,
+            tuples: Vec::new(),
+        };
+    }
+    let mut result = Automaton::new(name, kind);
+    let mut alphabet: Vec<EventId> = parts
+        .iter()
+        .flat_map(|p| p.alphabet().iter().copied())
+        .collect();
+    alphabet.sort_unstable();
+    alphabet.dedup();
+    result.alphabet = alphabet;
+    if parts.iter().any(|p| p.state_count() == 0) {
+        return ProductOutput {
+            automaton: result,
+            arity,
+            tuples: Vec::new(),
+        };
+    }
+    // owners[e] lists the components whose alphabet contains e, in component order.
+    let max_event = result.alphabet.last().map_or(0, |e| e.index() + 1);
+    let mut owners: Vec<Vec<usize>> = vec![Vec::new(); max_event];
+    for (c, p) in parts.iter().enumerate() {
+        for e in p.alphabet() {
+            owners[e.index()].push(c);
+        }
+    }
+    let mut index = TupleIndex::new(arity);
+    let start: Vec<u32> = parts.iter().map(|p| p.initial().0).collect();
+    index.find_or_insert(&start);
+    let mut cur = vec![0u32; arity];
+    let mut next = vec![0u32; arity];
+    let mut buf: Vec<Transition> = Vec::new();
+    let mut x = 0usize;
+    while x < index.len() {
+        cur.copy_from_slice(index.tuple(x));
+        buf.clear();
+        for (c, part) in parts.iter().enumerate() {
+            for tr in part.transitions(StateId(cur[c])) {
+                let own = &owners[tr.event.index()];
+                if own[0] != c {
+                    continue;
+                }
+                next.copy_from_slice(&cur);
+                next[c] = tr.target.0;
+                let (mut prob, mut lb) = (tr.prob, tr.lower_bound);
+                let mut enabled = true;
+                for &o in &own[1..] {
+                    match parts[o].transition(StateId(cur[o]), tr.event) {
+                        Some(t2) => {
+                            next[o] = t2.target.0;
+                            prob *= t2.prob;
+                            lb = lb.max(t2.lower_bound);
+                        }
+                        None => {
+                            enabled = false;
+                            break;
+                        }
+                    }
+                }
+                if !enabled {
+                    continue;
+                }
+                let target = index.find_or_insert(&next);
+                let ctrl = events.is_controllable(tr.event);
+                buf.push(Transition {
+                    event: tr.event,
+                    target: StateId(target),
+                    prob: if ctrl { prob } else { 1.0 },
+                    lower_bound: if ctrl { lb } else { 0 },
+                });
+            }
+        }
+        buf.sort_unstable_by_key(|t| t.event);
+        result.out.push(buf.clone());
+        x += 1;
+    }
+    let n = index.len();
+    result.marked = (0..n)
+        .map(|x| {
+            index
+                .tuple(x)
+                .iter()
+                .zip(parts)
+                .all(|(&s, p)| p.is_marked(StateId(s)))
+        })
+        .collect();
+    result.state_names = (0..n)
+        .map(|x| {
+            let t = index.tuple(x);
+            if arity == 1 {
+                parts[0].state_name(StateId(t[0])).to_owned()
+            } else {
+                let mut s = String::from("(");
+                for (i, (&q, p)) in t.iter().zip(parts).enumerate() {
+                    if i > 0 {
+                        s.push(',');
+                    }
+                    s.push_str(p.state_name(StateId(q)));
+                }
+                s.push(')');
+                s
+            }
+        })
+        .collect();
+    result.initial = StateId(0);
+    ProductOutput {
+        automaton: result,
+        arity,
+        tuples: index.tuples,
+    }
+}
+
+const EMPTY: u32 = u32::MAX;
+
+/// Open-addressing map from state tuples (stored flat) to dense ids.
+struct TupleIndex {
+    arity: usize,
+    tuples: Vec<u32>,
+    table: Vec<u32>,
+}
+
+impl TupleIndex {
+    fn new(arity: usize) -> Self {
+        Self {
+            arity,
+            tuples: Vec::new(),
+            table: vec![EMPTY; 1024],
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.tuples.len() / self.arity
+    }
+
+    fn tuple(&self, x: usize) -> &[u32] {
+        &self.tuples[x * self.arity..(x + 1) * self.arity]
+    }
+
+    fn hash(t: &[u32]) -> usize {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for &v in t {
+            h = (h ^ u64::from(v)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            h ^= h >> 29;
+        }
+        h as usize
+    }
+
+    fn find_or_insert(&mut self, t: &[u32]) -> u32 {
+        let mask = self.table.len() - 1;
+        let mut slot = Self::hash(t) & mask;
+        loop {
+            let id = self.table[slot];
+            if id == EMPTY {
+                break;
+            }
+            if self.tuple(id as usize) == t {
+                return id;
+            }
+            slot = (slot + 1) & mask;
+        }
+        let id = self.len() as u32;
+        self.tuples.extend_from_slice(t);
+        self.table[slot] = id;
+        if self.len() * 2 > self.table.len() {
+            self.grow();
+        }
+        id
+    }
+
+    fn grow(&mut self) {
+        let mut table = vec![EMPTY; self.table.len() * 2];
+        let mask = table.len() - 1;
+        for x in 0..self.len() {
+            let mut slot = Self::hash(self.tuple(x)) & mask;
+            while table[slot] != EMPTY {
+                slot = (slot + 1) & mask;
+            }
+            table[slot] = x as u32;
+        }
+        self.table = table;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The example of section 4.
+    #[test]
+    fn section_4_example_multiplies_shared_probabilities_and_takes_max_time() {
+        let mut ev = EventTable::new();
+        let a = ev.intern("a", true).unwrap();
+        let b = ev.intern("b", true).unwrap();
+        let c = ev.intern("c", true).unwrap();
+        let mut ga = Automaton::new("Ga", ModelKind::Spec);
+        let qa = ga.add_state("qa", true).unwrap();
+        ga.add_transition(qa, a, qa, 0.5, 2).unwrap();
+        ga.add_transition(qa, b, qa, 0.5, 0).unwrap();
+        let mut gb = Automaton::new("Gb", ModelKind::Spec);
+        let qb = gb.add_state("qb", true).unwrap();
+        gb.add_transition(qb, a, qb, 0.4, 5).unwrap();
+        gb.add_transition(qb, c, qb, 0.6, 0).unwrap();
+        let k = product("K", ModelKind::Spec, &ev, &[&ga, &gb]);
+        assert_eq!(k.state_count(), 1);
+        assert_eq!(k.state_name(StateId(0)), "(qa,qb)");
+        let labels: Vec<_> = k
+            .transitions(StateId(0))
+            .iter()
+            .map(|t| (t.event, t.prob, t.lower_bound))
+            .collect();
+        assert_eq!(labels.len(), 3);
+        assert_eq!(labels[0].0, a);
+        assert!((labels[0].1 - 0.2).abs() < 1e-12);
+        assert_eq!(labels[0].2, 5);
+        assert_eq!((labels[1].0, labels[1].1, labels[1].2), (b, 0.5, 0));
+        assert_eq!((labels[2].0, labels[2].1, labels[2].2), (c, 0.6, 0));
+    }
+
+    #[test]
+    fn c3_product_of_empty_list_is_identity() {
+        let ev = EventTable::new();
+        let id = product("I", ModelKind::Plant, &ev, &[]);
+        assert_eq!(id.state_count(), 1);
+        assert!(id.is_marked(StateId(0)));
+        assert!(id.alphabet().is_empty());
+    }
+
+    #[test]
+    fn c2_only_accessible_states_are_built() {
+        let mut ev = EventTable::new();
+        let a = ev.intern("a", true).unwrap();
+        let mut g = Automaton::new("g", ModelKind::Plant);
+        let s0 = g.add_state("s0", true).unwrap();
+        let s1 = g.add_state("s1", false).unwrap();
+        let _unreached = g.add_state("s2", false).unwrap();
+        g.add_transition(s0, a, s1, 1.0, 0).unwrap();
+        let mut h = Automaton::new("h", ModelKind::Spec);
+        let t0 = h.add_state("t0", true).unwrap();
+        h.add_transition(t0, a, t0, 1.0, 0).unwrap();
+        let k = product("k", ModelKind::Spec, &ev, &[&g, &h]);
+        // (s0,t0) -a-> (s1,t0); s1 has no a, so a is blocked there; s2 is never reached.
+        assert_eq!(k.state_count(), 2);
+        assert_eq!(k.transition_count(), 1);
+        assert!(k.is_marked(StateId(0)) && !k.is_marked(StateId(1)));
+    }
+
+    #[test]
+    fn tuple_index_survives_growth() {
+        let mut idx = TupleIndex::new(2);
+        for i in 0..5000u32 {
+            assert_eq!(idx.find_or_insert(&[i, i ^ 7]), i);
+        }
+        for i in 0..5000u32 {
+            assert_eq!(idx.find_or_insert(&[i, i ^ 7]), i);
+        }
+        assert_eq!(idx.len(), 5000);
+    }
+}

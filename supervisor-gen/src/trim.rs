@@ -1,0 +1,210 @@
+//! Accessible, coaccessible and trim parts (section 6.4), with the flat reverse adjacency SupC reuses.
+//!
+//! Reachability runs over a `removed` mask so SupC can re-run it every round without rebuilding graphs; the
+//! worklists and the reverse adjacency are flat `Vec`s sized once per automaton.
+
+use crate::automaton::{Automaton, EventId, StateId};
+
+/// Incoming transitions of every state in compressed form: the predecessors of `y` are
+/// `sources[offsets[y]..offsets[y + 1]]`, labelled by the same range of `events`.
+#[derive(Debug, Clone)]
+pub struct ReverseAdjacency {
+    offsets: Vec<u32>,
+    sources: Vec<u32>,
+    events: Vec<EventId>,
+}
+
+impl ReverseAdjacency {
+    /// Builds the reverse adjacency of `a` in two linear passes.
+    pub fn new(a: &Automaton) -> Self {
+        let n = a.state_count();
+        let mut offsets = vec![0u32; n + 1];
+        for t in a.out.iter().flatten() {
+            offsets[t.target.index() + 1] += 1;
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let m = offsets[n] as usize;
+        let mut fill = offsets.clone();
+        let mut sources = vec![0u32; m];
+        let mut events = vec![EventId(0); m];
+        for (x, list) in a.out.iter().enumerate() {
+            for t in list {
+                let slot = &mut fill[t.target.index()];
+                sources[*slot as usize] = x as u32;
+                events[*slot as usize] = t.event;
+                *slot += 1;
+            }
+        }
+        Self {
+            offsets,
+            sources,
+            events,
+        }
+    }
+
+    /// The (source, event) pairs of the transitions entering `y`.
+    pub fn incoming(&self, y: StateId) -> impl Iterator<Item = (StateId, EventId)> + '_ {
+        let (lo, hi) = (
+            self.offsets[y.index()] as usize,
+            self.offsets[y.index() + 1] as usize,
+        );
+        self.sources[lo..hi]
+            .iter()
+            .zip(&self.events[lo..hi])
+            .map(|(&s, &e)| (StateId(s), e))
+    }
+}
+
+/// States reachable from the initial state through states not in `removed`.
+pub fn accessible_mask(a: &Automaton, removed: &[bool]) -> Vec<bool> {
+    let n = a.state_count();
+    let mut seen = vec![false; n];
+    if n == 0 || removed[a.initial().index()] {
+        return seen;
+    }
+    let mut stack = vec![a.initial()];
+    seen[a.initial().index()] = true;
+    while let Some(x) = stack.pop() {
+        for t in a.transitions(x) {
+            let y = t.target.index();
+            if !seen[y] && !removed[y] {
+                seen[y] = true;
+                stack.push(t.target);
+            }
+        }
+    }
+    seen
+}
+
+/// States from which a marked state is reachable through states not in `removed`.
+pub fn coaccessible_mask(a: &Automaton, rev: &ReverseAdjacency, removed: &[bool]) -> Vec<bool> {
+    let n = a.state_count();
+    let mut seen = vec![false; n];
+    let mut stack: Vec<StateId> = Vec::new();
+    for x in a.states() {
+        if a.is_marked(x) && !removed[x.index()] {
+            seen[x.index()] = true;
+            stack.push(x);
+        }
+    }
+    while let Some(y) = stack.pop() {
+        for (x, _) in rev.incoming(y) {
+            if !seen[x.index()] && !removed[x.index()] {
+                seen[x.index()] = true;
+                stack.push(x);
+            }
+        }
+    }
+    seen
+}
+
+/// The sub-automaton on the states where `keep` is true, renumbered in ascending old order, dropping transitions
+/// into discarded states. Returns it with the old id of each new state. An automaton whose initial state is
+/// discarded has no states.
+pub fn restrict(a: &Automaton, keep: &[bool]) -> (Automaton, Vec<StateId>) {
+    let mut r = Automaton::new(a.name(), a.kind());
+    r.alphabet = a.alphabet.clone();
+    if a.state_count() == 0 || !keep[a.initial().index()] {
+        return (r, Vec::new());
+    }
+    let mut new_id = vec![u32::MAX; a.state_count()];
+    let mut old_of = Vec::new();
+    for x in a.states().filter(|x| keep[x.index()]) {
+        new_id[x.index()] = old_of.len() as u32;
+        old_of.push(x);
+    }
+    for &x in &old_of {
+        r.state_names.push(a.state_name(x).to_owned());
+        r.marked.push(a.is_marked(x));
+        r.out.push(
+            a.transitions(x)
+                .iter()
+                .filter(|t| keep[t.target.index()])
+                .map(|t| {
+                    let mut t = *t;
+                    t.target = StateId(new_id[t.target.index()]);
+                    t
+                })
+                .collect(),
+        );
+    }
+    r.initial = StateId(new_id[a.initial().index()]);
+    (r, old_of)
+}
+
+/// The accessible part of `a`.
+pub fn accessible(a: &Automaton) -> Automaton {
+    let keep = accessible_mask(a, &vec![false; a.state_count()]);
+    restrict(a, &keep).0
+}
+
+/// The coaccessible part of `a` (empty if the initial state cannot reach a marked state).
+pub fn coaccessible(a: &Automaton) -> Automaton {
+    let keep = coaccessible_mask(a, &ReverseAdjacency::new(a), &vec![false; a.state_count()]);
+    restrict(a, &keep).0
+}
+
+/// The trim part of `a`: accessible and coaccessible states only.
+pub fn trim(a: &Automaton) -> Automaton {
+    let none = vec![false; a.state_count()];
+    let acc = accessible_mask(a, &none);
+    let co = coaccessible_mask(a, &ReverseAdjacency::new(a), &none);
+    let keep: Vec<bool> = acc.iter().zip(&co).map(|(&x, &y)| x && y).collect();
+    restrict(a, &keep).0
+}
+
+/// Accessible states from which no marked state is reachable (empty iff `a` is nonblocking).
+pub fn blocking_states(a: &Automaton) -> Vec<StateId> {
+    let none = vec![false; a.state_count()];
+    let acc = accessible_mask(a, &none);
+    let co = coaccessible_mask(a, &ReverseAdjacency::new(a), &none);
+    a.states()
+        .filter(|x| acc[x.index()] && !co[x.index()])
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::automaton::ModelKind;
+
+    /// q0 -a-> q1 (marked), q0 -b-> q2 (dead end), q3 unreachable -a-> q1.
+    fn sample() -> Automaton {
+        let mut g = Automaton::new("g", ModelKind::Spec);
+        let q0 = g.add_state("q0", false).unwrap();
+        let q1 = g.add_state("q1", true).unwrap();
+        let q2 = g.add_state("q2", false).unwrap();
+        let q3 = g.add_state("q3", false).unwrap();
+        g.add_transition(q0, EventId(0), q1, 1.0, 0).unwrap();
+        g.add_transition(q0, EventId(1), q2, 1.0, 0).unwrap();
+        g.add_transition(q3, EventId(0), q1, 1.0, 0).unwrap();
+        g
+    }
+
+    #[test]
+    fn accessible_drops_unreachable_states() {
+        let a = accessible(&sample());
+        assert_eq!(a.state_count(), 3);
+        assert!(a.state_by_name("q3").is_none());
+    }
+
+    #[test]
+    fn coaccessible_drops_dead_ends() {
+        let c = coaccessible(&sample());
+        assert_eq!(c.state_count(), 3);
+        assert!(c.state_by_name("q2").is_none());
+        assert_eq!(c.transition_count(), 2);
+    }
+
+    #[test]
+    fn trim_is_accessible_and_coaccessible() {
+        let t = trim(&sample());
+        let names: Vec<_> = t.states().map(|s| t.state_name(s).to_owned()).collect();
+        assert_eq!(names, vec!["q0", "q1"]);
+        assert_eq!(t.transition_count(), 1);
+        assert_eq!(blocking_states(&sample()), vec![StateId(2)]);
+        assert!(blocking_states(&t).is_empty());
+    }
+}
