@@ -10,7 +10,9 @@ use std::fmt;
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
 
-use crate::contract::{CompiledEvent, EventCallbacks};
+use supervisor_gen::compiled::CompiledEvent;
+
+use crate::contract::EventCallbacks;
 use crate::profile::{Procedure, Profile};
 
 /// Why a profile does not fit a supervisor set; lists every mismatch at once.

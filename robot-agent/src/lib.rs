@@ -11,3 +11,4 @@ pub mod native;
 pub mod params;
 pub mod profile;
 pub mod profiles;
+pub mod supervisors;

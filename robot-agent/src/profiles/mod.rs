@@ -8,7 +8,9 @@ pub mod timer;
 use thiserror::Error;
 
 use crate::binding::{BindError, bind};
-use crate::contract::{CompiledEvent, EventCallbacks};
+use supervisor_gen::compiled::CompiledEvent;
+
+use crate::contract::EventCallbacks;
 use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
