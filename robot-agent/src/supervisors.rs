@@ -19,7 +19,7 @@ use thiserror::Error;
 use tracing::warn;
 
 /// One model file: the name diagnostics use, and its text.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ModelText<'a> {
     /// File name as shown in diagnostics.
     pub file: &'a str,

@@ -46,6 +46,11 @@ pub enum NativeError {
     },
 }
 
+/// Names of all registered native controllers.
+pub fn native_names() -> impl Iterator<Item = &'static str> {
+    NATIVE.iter().map(|(name, _)| *name)
+}
+
 /// Whether a native controller of this name is registered.
 pub fn is_native(name: &str) -> bool {
     NATIVE.iter().any(|(n, _)| *n == name)
