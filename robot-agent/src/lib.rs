@@ -7,6 +7,7 @@
 
 pub mod binding;
 pub mod contract;
+pub mod control;
 pub mod controller;
 pub mod native;
 pub mod params;

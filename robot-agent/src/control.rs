@@ -1,0 +1,134 @@
+//! A robot's built controller: everything loaded, bound and checked before the first tick.
+//!
+//! Building turns a [`Plan`] into a [`Control`]: it loads or synthesises the supervisor set, binds every event to
+//! the profile's callbacks (one error listing all mismatches), or builds the native controller. Every failure here
+//! happens at startup, so the agent can exit non-zero with the reason before tick 1.
+
+use supervisor_gen::compiled::SupervisorSet;
+use thiserror::Error;
+use tracing::info;
+
+use crate::controller::{Plan, Supervisors};
+use crate::native::{self, BoxedNative, NativeError};
+use crate::params::Params;
+use crate::profiles::{self, BoxedCallbacks, ProfileError};
+use crate::supervisors::{self, SupervisorError};
+
+/// A controller ready to run.
+pub enum Control {
+    /// Supervisors and the profile callbacks bound to their events.
+    Supervised {
+        /// The supervisor set.
+        set: SupervisorSet,
+        /// The bound callbacks.
+        callbacks: BoxedCallbacks,
+    },
+    /// A native controller.
+    Native(BoxedNative),
+}
+
+/// Why a controller could not be built.
+#[derive(Debug, Error)]
+pub enum BuildError {
+    /// The supervisors could not be loaded.
+    #[error("supervisors {where_}: {source}")]
+    Supervisors {
+        /// Where they were loaded from.
+        where_: String,
+        /// What went wrong.
+        source: SupervisorError,
+    },
+    /// The profile could not be set up or bound.
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    /// The native controller could not be built.
+    #[error(transparent)]
+    Native(#[from] NativeError),
+}
+
+/// Loads, binds and checks everything `plan` needs, with parameters from `params`.
+pub fn build(plan: &Plan, params: &Params) -> Result<Control, BuildError> {
+    match plan {
+        Plan::Supervised {
+            profile,
+            supervisors,
+        } => {
+            let (where_, loaded) = match supervisors {
+                Supervisors::Builtin(name, models) => {
+                    (format!("built-in {name}"), supervisors::synthesise(models))
+                }
+                Supervisors::Path(path) => (path.display().to_string(), supervisors::load(path)),
+            };
+            let set = loaded.map_err(|source| BuildError::Supervisors {
+                where_: where_.clone(),
+                source,
+            })?;
+            let callbacks = profiles::bind_profile(profile, params, &set.events)?;
+            info!(
+                profile = profile.as_str(),
+                supervisors = where_.as_str(),
+                count = set.supervisors.len(),
+                events = set.events.len(),
+                "supervised controller bound"
+            );
+            Ok(Control::Supervised { set, callbacks })
+        }
+        Plan::Native { name } => {
+            let controller = native::build_native(name, params)?;
+            info!(native = name.as_str(), "native controller built");
+            Ok(Control::Native(controller))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::supervisors::OBSTACLE_AVOIDANCE_PTSCT;
+
+    #[test]
+    fn builtin_thesis_controller_builds_and_binds() {
+        let plan = Plan::Supervised {
+            profile: "obstacle_avoidance".to_owned(),
+            supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
+        };
+        assert!(matches!(
+            build(&plan, &Params::default()),
+            Ok(Control::Supervised { .. })
+        ));
+    }
+
+    #[test]
+    fn wrong_profile_for_the_builtin_models_fails_at_build() {
+        let plan = Plan::Supervised {
+            profile: "obstacle_avoidance_sct".to_owned(),
+            supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
+        };
+        let err = build(&plan, &Params::default()).err().unwrap();
+        assert!(matches!(err, BuildError::Profile(ProfileError::Bind(_))));
+    }
+
+    #[test]
+    fn missing_supervisor_file_names_the_path() {
+        let plan = Plan::Supervised {
+            profile: "obstacle_avoidance".to_owned(),
+            supervisors: Supervisors::Path("/nonexistent/oa.sup".into()),
+        };
+        let err = build(&plan, &Params::default()).err().unwrap().to_string();
+        assert!(
+            err.starts_with("supervisors /nonexistent/oa.sup: "),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn native_plan_builds_the_argos_port() {
+        let plan = Plan::Native {
+            name: "epuck_obstacleavoidance".to_owned(),
+        };
+        assert!(matches!(
+            build(&plan, &Params::default()),
+            Ok(Control::Native(_))
+        ));
+    }
+}
