@@ -31,12 +31,12 @@ pub enum Control {
 #[derive(Debug, Error)]
 pub enum BuildError {
     /// The supervisors could not be loaded.
-    #[error("supervisors {where_}: {source}")]
+    #[error("supervisors {where_}: {problem}")]
     Supervisors {
         /// Where they were loaded from.
         where_: String,
         /// What went wrong.
-        source: SupervisorError,
+        problem: SupervisorError,
     },
     /// The profile could not be set up or bound.
     #[error(transparent)]
@@ -53,15 +53,14 @@ pub fn build(plan: &Plan, params: &Params) -> Result<Control, BuildError> {
             profile,
             supervisors,
         } => {
-            let (where_, loaded) = match supervisors {
-                Supervisors::Builtin(name, models) => {
-                    (format!("built-in {name}"), supervisors::synthesise(models))
-                }
-                Supervisors::Path(path) => (path.display().to_string(), supervisors::load(path)),
+            let where_ = supervisors.to_string();
+            let loaded = match supervisors {
+                Supervisors::Builtin(_, models) => supervisors::synthesise(models),
+                Supervisors::Path(path) => supervisors::load(path),
             };
-            let set = loaded.map_err(|source| BuildError::Supervisors {
+            let set = loaded.map_err(|problem| BuildError::Supervisors {
                 where_: where_.clone(),
-                source,
+                problem,
             })?;
             let callbacks = profiles::bind_profile(profile, params, &set.events)?;
             info!(

@@ -8,6 +8,7 @@
 //! (ARGoS style): the thesis' and ARGoS' controller names map to built-ins, and a native controller's own name
 //! selects it.
 
+use std::fmt;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
@@ -43,6 +44,27 @@ pub enum Supervisors {
     Builtin(&'static str, &'static [ModelText<'static>]),
     /// A folder of XML models or a compiled supervisor file, already resolved against the config's folder.
     Path(PathBuf),
+}
+
+impl fmt::Display for Supervisors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Supervisors::Builtin(name, _) => write!(f, "built-in {name}"),
+            Supervisors::Path(path) => write!(f, "{}", path.display()),
+        }
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Plan::Supervised {
+                profile,
+                supervisors,
+            } => write!(f, "profile `{profile}` with supervisors {supervisors}"),
+            Plan::Native { name } => write!(f, "native controller `{name}`"),
+        }
+    }
 }
 
 /// A built-in controller element name (ARGoS or thesis) and what it stands for.
@@ -137,7 +159,7 @@ pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, Pla
         (None, None) => {
             if let Some(builtin) = BUILTINS.iter().find(|b| b.element == element) {
                 let plan = (builtin.plan)();
-                info!(element, ?plan, "controller element maps to a built-in");
+                info!("controller element `{element}` maps to {plan}");
                 plan
             } else if native::is_native(element) {
                 Plan::Native {

@@ -68,12 +68,12 @@ impl fmt::Display for Diagnostics {
 #[derive(Debug, Error)]
 pub enum SupervisorError {
     /// A model file or folder could not be read.
-    #[error("cannot read {}: {source}", path.display())]
+    #[error("cannot read {}: {problem}", path.display())]
     Io {
         /// The file or folder.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        problem: std::io::Error,
     },
     /// A folder of models holds no `.xml` file.
     #[error("{}: no .xml model files in this folder", path.display())]
@@ -103,9 +103,9 @@ pub fn load(path: &Path) -> Result<SupervisorSet, SupervisorError> {
     if !path.is_dir() {
         return Ok(SupervisorSet::read(path)?);
     }
-    let io = |source| SupervisorError::Io {
+    let io = |problem| SupervisorError::Io {
         path: path.to_owned(),
-        source,
+        problem,
     };
     let mut files: Vec<PathBuf> = std::fs::read_dir(path)
         .map_err(io)?
@@ -121,9 +121,9 @@ pub fn load(path: &Path) -> Result<SupervisorSet, SupervisorError> {
     }
     let mut texts = Vec::with_capacity(files.len());
     for file in &files {
-        let text = std::fs::read_to_string(file).map_err(|source| SupervisorError::Io {
+        let text = std::fs::read_to_string(file).map_err(|problem| SupervisorError::Io {
             path: file.clone(),
-            source,
+            problem,
         })?;
         texts.push((file.display().to_string(), text));
     }

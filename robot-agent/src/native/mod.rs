@@ -37,12 +37,12 @@ pub enum NativeError {
         known: String,
     },
     /// A parameter is bad.
-    #[error("native controller `{name}`: {source}")]
+    #[error("native controller `{name}`: {problem}")]
     Param {
         /// The controller.
         name: String,
         /// The parameter problem.
-        source: ParamError,
+        problem: ParamError,
     },
 }
 
@@ -68,8 +68,8 @@ pub fn build_native(name: &str, params: &Params) -> Result<BoxedNative, NativeEr
                 .join(", "),
         });
     };
-    build(params).map_err(|source| NativeError::Param {
+    build(params).map_err(|problem| NativeError::Param {
         name: name.to_owned(),
-        source,
+        problem,
     })
 }

@@ -42,12 +42,12 @@ pub enum ProfileError {
         known: String,
     },
     /// A parameter of the profile is bad.
-    #[error("profile `{profile}`: {source}")]
+    #[error("profile `{profile}`: {problem}")]
     Param {
         /// The profile.
         profile: &'static str,
         /// The parameter problem.
-        source: ParamError,
+        problem: ParamError,
     },
     /// The profile's callbacks do not fit the supervisors.
     #[error(transparent)]
@@ -83,9 +83,9 @@ fn bind_boxed<P: Profile>(
     params: &Params,
     events: &[CompiledEvent],
 ) -> Result<BoxedCallbacks, ProfileError> {
-    let state = P::from_params(params).map_err(|source| ProfileError::Param {
+    let state = P::from_params(params).map_err(|problem| ProfileError::Param {
         profile: P::NAME,
-        source,
+        problem,
     })?;
     Ok(Box::new(bind(state, events)?))
 }
