@@ -4,4 +4,5 @@
 //! hold the ptSCT player, the transports (iceoryx2 locally, zenoh across hosts) and the launcher behind `swarm`.
 //! It never depends on the world or on the robot agent.
 
+pub mod config;
 pub mod messages;

@@ -1,0 +1,40 @@
+//! The experiment configuration: the `.argos` format (ARGoS' XML) read into a typed, located model.
+//!
+//! - [`model`]: the types the launcher and the world build from; every item knows its line and column.
+//! - [`diagnostic`]: located errors and warnings, `file:line:column: message (hint)`.
+//! - `xml` reads the text into a located element tree, `parse` interprets it section by section and `registry`
+//!   maps device names to kinds.
+//!
+//! `docs/configuration.md` lists every supported element and attribute, our extensions, and the controller params
+//! the agent's profiles read. This module never depends on the world or the robot agent, and never panics on user
+//! input: every problem becomes a [`Diagnostic`].
+
+pub mod diagnostic;
+pub mod model;
+mod parse;
+mod registry;
+mod suggest;
+mod values;
+mod xml;
+
+use std::path::Path;
+
+pub use diagnostic::{ConfigErrors, Diagnostic};
+pub use model::*;
+
+impl Experiment {
+    /// Reads and checks an experiment file. On success returns the experiment and its warnings (harmless
+    /// unsupported elements and attributes, a seed left to the clock, ...); on failure every error found, each
+    /// located `file:line:column`.
+    pub fn load(path: impl AsRef<Path>) -> Result<(Experiment, Vec<Diagnostic>), ConfigErrors> {
+        parse::load(path.as_ref())
+    }
+
+    /// Parses configuration text as if it had been read from `path` (used for messages and relative paths).
+    pub fn parse(
+        path: impl AsRef<Path>,
+        text: &str,
+    ) -> Result<(Experiment, Vec<Diagnostic>), ConfigErrors> {
+        parse::parse_str(path.as_ref(), text)
+    }
+}

@@ -1,0 +1,82 @@
+//! `<framework>`: `<system threads>` and `<experiment length ticks_per_second random_seed>`.
+
+use super::Ctx;
+use crate::config::model::{Element, Framework, Location};
+
+const CHILDREN: &[&str] = &["system", "experiment", "profiling"];
+
+/// Parses `<framework>`.
+pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
+    ctx.unknown_attributes(el, &[]);
+    let mut threads = 0;
+    let mut experiment: Option<(&Element, Location)> = None;
+    let mut system_at: Option<Location> = None;
+    for child in &el.children {
+        match child.name.as_str() {
+            "system" => {
+                if let Some(first) = system_at {
+                    ctx.duplicate(child, &el.name, first);
+                }
+                system_at = Some(child.location);
+                ctx.unknown_attributes(child, &["threads", "method", "pin_threads_to_cores"]);
+                threads = ctx.attr(child, "threads").unwrap_or(0);
+            }
+            "experiment" => match experiment {
+                Some((_, first)) => ctx.duplicate(child, &el.name, first),
+                None => experiment = Some((child, child.location)),
+            },
+            "profiling" => ctx.warn(
+                child.location,
+                "<profiling> is ignored: use `cargo bench` and the run log",
+                None,
+            ),
+            _ => ctx.unknown_element(child, &el.name, CHILDREN),
+        }
+    }
+    let Some((exp, location)) = experiment else {
+        ctx.error(el.location, "<framework> has no <experiment> element", None);
+        return None;
+    };
+    ctx.unknown_attributes(
+        exp,
+        &[
+            "length",
+            "ticks_per_second",
+            "random_seed",
+            "real_time",
+            "visualization",
+        ],
+    );
+    let length_seconds: f64 = ctx.attr(exp, "length").unwrap_or(0.0);
+    ctx.in_range(exp, "length", length_seconds, 0.0, None);
+    let ticks_per_second: u32 = ctx.required(exp, "ticks_per_second")?;
+    if ticks_per_second == 0 {
+        let at = exp
+            .attributes
+            .get("ticks_per_second")
+            .map_or(location, |a| a.location);
+        ctx.error(
+            at,
+            "'ticks_per_second' in <experiment> must be greater than 0",
+            None,
+        );
+        return None;
+    }
+    let random_seed = ctx
+        .attr::<u64>(exp, "random_seed")
+        .filter(|&seed| seed != 0);
+    if random_seed.is_none() {
+        ctx.warn(
+            location,
+            "no random_seed (absent or 0): the launcher draws one from the clock and prints it",
+            None,
+        );
+    }
+    Some(Framework {
+        threads,
+        length_seconds,
+        ticks_per_second,
+        random_seed,
+        location,
+    })
+}

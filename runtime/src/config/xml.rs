@@ -1,0 +1,307 @@
+//! Reads XML text into an owned, located element tree ([`Element`]) with quick-xml's streaming reader.
+//!
+//! Every element and attribute gets the line and column where it starts, computed from quick-xml's byte offsets.
+//! Malformed XML becomes one located [`Diagnostic`]. This module knows nothing about the `.argos` vocabulary.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use quick_xml::Reader;
+use quick_xml::events::{BytesStart, Event};
+
+use super::diagnostic::Diagnostic;
+use super::model::{Attribute, Element, Location};
+
+/// Maps byte offsets of one text to 1-based line and column (columns count characters, not bytes).
+pub(crate) struct LineIndex<'a> {
+    text: &'a str,
+    line_starts: Vec<usize>,
+}
+
+impl<'a> LineIndex<'a> {
+    /// Indexes the line starts of `text`.
+    pub(crate) fn new(text: &'a str) -> Self {
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Self { text, line_starts }
+    }
+
+    /// The location of a byte offset (clamped to the text).
+    pub(crate) fn locate(&self, offset: usize) -> Location {
+        let offset = offset.min(self.text.len());
+        let line = self.line_starts.partition_point(|&start| start <= offset) - 1;
+        let start = self.line_starts[line];
+        let column = self
+            .text
+            .get(start..offset)
+            .map_or(offset - start, |prefix| prefix.chars().count());
+        Location {
+            line: to_u32(line + 1),
+            column: to_u32(column + 1),
+        }
+    }
+}
+
+fn to_u32(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+
+/// Parses `text` (the contents of `path`) into its root element.
+pub(crate) fn parse_tree(path: &Path, text: &str) -> Result<Element, Diagnostic> {
+    let index = LineIndex::new(text);
+    let error = |offset: usize, message: String| {
+        Diagnostic::new(path.to_path_buf(), index.locate(offset), message)
+    };
+
+    let mut reader = Reader::from_str(text);
+    let config = reader.config_mut();
+    config.check_end_names = true;
+    config.trim_text(false);
+
+    // The stack of open elements; the root ends up as the single finished top-level element.
+    let mut stack: Vec<Element> = Vec::new();
+    let mut root: Option<Element> = None;
+    loop {
+        let event = reader.read_event().map_err(|e| {
+            error(
+                offset(reader.error_position()),
+                format!("malformed XML: {e}"),
+            )
+        })?;
+        let end = offset(reader.buffer_position());
+        match event {
+            Event::Start(start) => {
+                let element =
+                    open_element(&start, end, 2, text, &index).map_err(|(at, m)| error(at, m))?;
+                stack.push(element);
+            }
+            Event::Empty(start) => {
+                let element =
+                    open_element(&start, end, 3, text, &index).map_err(|(at, m)| error(at, m))?;
+                close_element(element, &mut stack, &mut root).map_err(|m| error(end, m))?;
+            }
+            Event::End(_) => {
+                if let Some(element) = stack.pop() {
+                    close_element(element, &mut stack, &mut root).map_err(|m| error(end, m))?;
+                }
+            }
+            Event::Text(t) => {
+                let decoded = t
+                    .decode()
+                    .map_err(|e| error(end, format!("malformed text: {e}")))?;
+                push_text(&mut stack, &decoded);
+            }
+            Event::CData(t) => {
+                let decoded = t
+                    .decode()
+                    .map_err(|e| error(end, format!("malformed CDATA: {e}")))?;
+                push_text(&mut stack, &decoded);
+            }
+            Event::GeneralRef(r) => {
+                let name = r
+                    .decode()
+                    .map_err(|e| error(end, format!("malformed reference: {e}")))?;
+                let resolved = resolve_reference(&name)
+                    .ok_or_else(|| error(end, format!("unknown entity '&{name};'")))?;
+                push_text(&mut stack, &resolved);
+            }
+            Event::Eof => break,
+            Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_) => {}
+        }
+    }
+    if let Some(open) = stack.last() {
+        return Err(Diagnostic::new(
+            path.to_path_buf(),
+            open.location,
+            format!("<{}> is never closed", open.name),
+        ));
+    }
+    root.ok_or_else(|| error(0, "the file contains no XML element".to_string()))
+}
+
+/// Resolves `amp`, `lt`, ... and character references `#65` / `#x41`.
+fn resolve_reference(name: &str) -> Option<String> {
+    if let Some(number) = name.strip_prefix('#') {
+        let code = match number.strip_prefix('x') {
+            Some(hex) => u32::from_str_radix(hex, 16).ok()?,
+            None => number.parse().ok()?,
+        };
+        return char::from_u32(code).map(String::from);
+    }
+    quick_xml::escape::resolve_predefined_entity(name).map(str::to_string)
+}
+
+fn offset(position: u64) -> usize {
+    usize::try_from(position).unwrap_or(usize::MAX)
+}
+
+fn push_text(stack: &mut [Element], text: &str) {
+    if let Some(top) = stack.last_mut() {
+        top.text.push_str(text);
+    }
+}
+
+fn close_element(
+    mut element: Element,
+    stack: &mut [Element],
+    root: &mut Option<Element>,
+) -> Result<(), String> {
+    element.text = element.text.trim().to_string();
+    match stack.last_mut() {
+        Some(parent) => parent.children.push(element),
+        None if root.is_none() => *root = Some(element),
+        None => {
+            return Err(format!(
+                "second top-level element <{}>: an XML file has one root",
+                element.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Builds an element from a start tag that ended at byte `end`; `markup` is the number of bytes around the tag's
+/// content (`<` and `>`, plus `/` for empty tags). Errors carry a byte offset.
+fn open_element(
+    start: &BytesStart<'_>,
+    end: usize,
+    markup: usize,
+    text: &str,
+    index: &LineIndex<'_>,
+) -> Result<Element, (usize, String)> {
+    let content_len = start.len();
+    let tag_start = end.saturating_sub(content_len + markup);
+    let content_start = tag_start + 1;
+    let name = std::str::from_utf8(start.name().as_ref())
+        .map_err(|e| (tag_start, format!("tag name is not UTF-8: {e}")))?
+        .to_string();
+    let raw = text
+        .get(content_start..content_start + content_len)
+        .unwrap_or("");
+
+    let mut attributes = BTreeMap::new();
+    let mut cursor = name.len();
+    for attribute in start.attributes() {
+        let attribute = attribute.map_err(|e| {
+            let at = match &e {
+                quick_xml::events::attributes::AttrError::ExpectedEq(p)
+                | quick_xml::events::attributes::AttrError::ExpectedValue(p)
+                | quick_xml::events::attributes::AttrError::UnquotedValue(p)
+                | quick_xml::events::attributes::AttrError::ExpectedQuote(p, _)
+                | quick_xml::events::attributes::AttrError::Duplicated(p, _) => content_start + p,
+            };
+            (at, format!("malformed attribute in <{name}>: {e}"))
+        })?;
+        let key = std::str::from_utf8(attribute.key.as_ref())
+            .map_err(|e| {
+                (
+                    tag_start,
+                    format!("attribute name in <{name}> is not UTF-8: {e}"),
+                )
+            })?
+            .to_string();
+        let value = attribute
+            .unescape_value()
+            .map_err(|e| (tag_start, format!("bad value of '{key}' in <{name}>: {e}")))?
+            .into_owned();
+        let (key_at, after) = find_attribute(raw, cursor, &key);
+        cursor = after;
+        let location = index.locate(content_start + key_at);
+        attributes.insert(key, Attribute { value, location });
+    }
+    Ok(Element {
+        name,
+        attributes,
+        children: Vec::new(),
+        text: String::new(),
+        location: index.locate(tag_start),
+    })
+}
+
+/// Finds attribute `key` in the raw tag content from `cursor`; returns its offset and the offset after its value.
+fn find_attribute(raw: &str, cursor: usize, key: &str) -> (usize, usize) {
+    let bytes = raw.as_bytes();
+    let mut from = cursor.min(raw.len());
+    while let Some(found) = raw.get(from..).and_then(|rest| rest.find(key)) {
+        let at = from + found;
+        let preceded = at == 0 || bytes[at - 1].is_ascii_whitespace();
+        let rest = raw[at + key.len()..].trim_start();
+        if preceded && rest.starts_with('=') {
+            let value = rest[1..].trim_start();
+            let value_start = raw.len() - value.len();
+            let after = value
+                .chars()
+                .next()
+                .and_then(|quote| value[1..].find(quote).map(|close| value_start + close + 2))
+                .unwrap_or(raw.len());
+            return (at, after);
+        }
+        from = at + key.len();
+    }
+    (cursor, cursor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_count_characters_on_each_line() {
+        let text = "ab\n\u{e9}x<y";
+        let index = LineIndex::new(text);
+        assert_eq!(index.locate(0), Location { line: 1, column: 1 });
+        assert_eq!(index.locate(3), Location { line: 2, column: 1 });
+        assert_eq!(
+            index.locate(text.find('<').unwrap_or(0)),
+            Location { line: 2, column: 3 }
+        );
+    }
+
+    #[test]
+    fn elements_and_attributes_are_located() {
+        let text = "<a>\n  <b x=\"1\"  y = '2'/>\n  <c>t &amp; u</c>\n</a>";
+        let root = parse_tree(Path::new("f.argos"), text).expect("well-formed");
+        assert_eq!(root.location, Location { line: 1, column: 1 });
+        let b = &root.children[0];
+        assert_eq!(b.location, Location { line: 2, column: 3 });
+        assert_eq!(b.attributes["x"].location, Location { line: 2, column: 6 });
+        assert_eq!(
+            b.attributes["y"].location,
+            Location {
+                line: 2,
+                column: 13
+            }
+        );
+        assert_eq!(b.attributes["y"].value, "2");
+        assert_eq!(root.children[1].text, "t & u");
+    }
+
+    #[test]
+    fn attribute_names_inside_values_do_not_confuse_locations() {
+        let text = "<a p=\"q=1\" q=\"2\"/>";
+        let root = parse_tree(Path::new("f.argos"), text).expect("well-formed");
+        assert_eq!(
+            root.attributes["q"].location,
+            Location {
+                line: 1,
+                column: 12
+            }
+        );
+    }
+
+    #[test]
+    fn mismatched_end_tag_is_a_located_error() {
+        let text = "<a>\n  <b>\n  </c>\n</a>";
+        let err = parse_tree(Path::new("f.argos"), text).expect_err("ill-formed");
+        assert_eq!(err.location.line, 3);
+        assert!(err.message.starts_with("malformed XML"), "{}", err.message);
+    }
+
+    #[test]
+    fn unclosed_element_is_reported_where_it_opens() {
+        let text = "<a>\n  <b>\n";
+        let err = parse_tree(Path::new("f.argos"), text).expect_err("ill-formed");
+        assert!(err.location.line >= 1, "{err}");
+    }
+}
