@@ -9,6 +9,7 @@ pub mod binding;
 pub mod contract;
 pub mod control;
 pub mod controller;
+pub mod from_config;
 pub mod native;
 pub mod params;
 pub mod profile;

@@ -1,5 +1,116 @@
-//! `robot-agent`: one robot's process.
+//! `robot-agent`: one robot's process. Loads and checks its controller before the first tick, so every startup
+//! failure (unknown controller or profile, bad supervisor file, unbound event, bad parameter) exits non-zero with
+//! the reason for the launcher to report.
 
-fn main() {
-    println!("robot-agent: not yet implemented");
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, anyhow};
+use clap::Parser;
+use robot_agent::control::{self, Control};
+use robot_agent::controller;
+use robot_agent::from_config;
+use robot_agent::params::Params;
+use swarm_runtime::config::Experiment;
+use tracing::{debug, info};
+
+/// One robot of a swarm run.
+#[derive(Debug, Parser)]
+#[command(name = "robot-agent", version)]
+struct Args {
+    /// Run id: names the run's shared-memory services.
+    #[arg(long)]
+    run: String,
+    /// Index of this robot in the run (0..N).
+    #[arg(long)]
+    robot: u32,
+    /// Experiment configuration (.argos); the robot runs the controller named by --controller.
+    #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
+    config: Option<PathBuf>,
+    /// Id of the robot's controller in --config (default: the configuration's only controller).
+    #[arg(long, requires = "config")]
+    controller: Option<String>,
+    /// Without --config: controller element name, as a `<controllers>` child would be named.
+    #[arg(long, default_value = "")]
+    element: String,
+    /// Without --config: operational-procedure profile (with --supervisors).
+    #[arg(long, requires = "supervisors")]
+    profile: Option<String>,
+    /// Without --config: folder of XML models or compiled supervisor-set file (with --profile), relative to the
+    /// working directory.
+    #[arg(long, requires = "profile")]
+    supervisors: Option<String>,
+    /// Without --config: controller parameter, as an attribute of <params> (repeatable), e.g. --param velocity=5.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    params: Vec<(String, String)>,
+    /// Load, synthesise and bind the controller, then exit without joining the run.
+    #[arg(long)]
+    check: bool,
+}
+
+fn parse_param(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, value)) if !name.is_empty() => Ok((name.to_owned(), value.to_owned())),
+        _ => Err(format!("`{s}` is not NAME=VALUE")),
+    }
+}
+
+/// Plans and builds the robot's controller from the configuration or from the manual flags.
+fn build_control(args: &Args) -> Result<Control> {
+    if let Some(path) = &args.config {
+        let (experiment, warnings) =
+            Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
+        for w in &warnings {
+            debug!("{w}");
+        }
+        let controller = from_config::choose(&experiment, args.controller.as_deref())?;
+        let (plan, control) = from_config::build(&experiment, controller)?;
+        info!(controller = controller.id.as_str(), "robot runs {plan}");
+        return Ok(control);
+    }
+    let mut pairs = args.params.clone();
+    if let (Some(profile), Some(supervisors)) = (&args.profile, &args.supervisors) {
+        pairs.push(("profile".to_owned(), profile.clone()));
+        pairs.push(("supervisors".to_owned(), supervisors.clone()));
+    }
+    let params = Params::new(pairs);
+    let base_dir = std::env::current_dir().context("cannot resolve relative paths")?;
+    let plan = controller::plan(&args.element, &params, &base_dir)?;
+    let control = control::build(&plan, &params)?;
+    info!("robot runs {plan}");
+    Ok(control)
+}
+
+fn run(args: Args) -> Result<()> {
+    let _control = build_control(&args)
+        .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
+    info!(
+        run = args.run.as_str(),
+        robot = args.robot,
+        "controller ready"
+    );
+    if args.check {
+        return Ok(());
+    }
+    anyhow::bail!(
+        "robot {}: joining a run needs the transport, which this build does not have yet",
+        args.robot
+    )
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(Args::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
 }
