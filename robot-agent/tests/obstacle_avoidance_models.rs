@@ -155,3 +155,43 @@ fn each_variant_binds_to_its_profile_and_not_to_the_other() {
          not have: `start_timer_1`, `timer_1_lw_5`, `inc_timer_1`, `timer_1_eq_5`, `end_timer_1`"
     );
 }
+
+#[test]
+fn ptsct_supervisors_have_two_states_each_and_memcons_107_bytes() {
+    let s = synthesise(
+        "ptsct",
+        &["G_prox.xml", "G_motor.xml", "E_walk.xml", "E_avoid.xml"],
+    );
+    for sup in &s.supervisors {
+        assert_eq!(
+            (sup.stats.states, sup.stats.transitions),
+            (2, 6),
+            "{}",
+            sup.name
+        );
+    }
+    // s = 4, t = 12, t_c = 10, e = 5, N = 2: (4 + 36) + 2 (4 + 20) + 5 + 7 * 2 (ptsct.md section 9).
+    assert_eq!(s.compile().unwrap().mem_cons(), 107);
+}
+
+#[test]
+fn sct_walk_supervisor_grows_to_six_states_and_memcons_189_bytes() {
+    let s = synthesise(
+        "sct",
+        &[
+            "G_prox.xml",
+            "G_motor.xml",
+            "G_timer1.xml",
+            "E_walk.xml",
+            "E_avoid.xml",
+        ],
+    );
+    let sizes: Vec<(&str, usize, usize)> = s
+        .supervisors
+        .iter()
+        .map(|x| (x.name.as_str(), x.stats.states, x.stats.transitions))
+        .collect();
+    assert_eq!(sizes, [("S_E_walk", 6, 15), ("S_E_avoid", 2, 6)]);
+    // s = 8, t = 21, t_c = 17, e = 10, N = 2: (8 + 63) + 2 (8 + 34) + 10 + 12 * 2.
+    assert_eq!(s.compile().unwrap().mem_cons(), 189);
+}
