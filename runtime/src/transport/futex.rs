@@ -1,0 +1,51 @@
+//! Linux futex wait/wake on a 32-bit word in shared memory.
+//!
+//! The lockstep protocol parks every agent on one word and wakes them all with one `FUTEX_WAKE` (design.md:
+//! one broadcast is far cheaper than one channel per robot). The word lives in a `MAP_SHARED` mapping, so the
+//! shared (non-private) futex operations are used. This module must never spin: callers decide how long to spin
+//! before they block here.
+
+use std::sync::atomic::AtomicU32;
+use std::time::Duration;
+
+/// Blocks while `word` still holds `expected`, for at most `timeout` (forever when `None`).
+///
+/// Returns on a wake-up, a value change, a signal or the timeout; callers re-check their condition in a loop,
+/// so every return is a "maybe" and no error is worth reporting.
+pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) {
+    let spec = timeout.map(|t| libc::timespec {
+        tv_sec: libc::time_t::try_from(t.as_secs()).unwrap_or(libc::time_t::MAX),
+        tv_nsec: libc::c_long::from(t.subsec_nanos()),
+    });
+    let spec_ptr = spec
+        .as_ref()
+        .map_or(std::ptr::null(), |s| s as *const libc::timespec);
+    // SAFETY: `word` is a live, aligned 32-bit atomic; the kernel only reads it. The timespec outlives the call.
+    unsafe {
+        libc::syscall(
+            libc::SYS_futex,
+            word.as_ptr(),
+            libc::FUTEX_WAIT,
+            expected,
+            spec_ptr,
+            std::ptr::null::<u32>(),
+            0u32,
+        );
+    }
+}
+
+/// Wakes at most `count` processes blocked in [`wait`] on `word` (`i32::MAX` wakes all).
+pub fn wake(word: &AtomicU32, count: i32) {
+    // SAFETY: `word` is a live, aligned 32-bit atomic; FUTEX_WAKE does not touch memory.
+    unsafe {
+        libc::syscall(
+            libc::SYS_futex,
+            word.as_ptr(),
+            libc::FUTEX_WAKE,
+            count,
+            std::ptr::null::<libc::timespec>(),
+            std::ptr::null::<u32>(),
+            0u32,
+        );
+    }
+}

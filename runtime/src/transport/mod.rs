@@ -1,0 +1,136 @@
+//! Local transport of the lockstep tick protocol over iceoryx2 shared memory.
+//!
+//! One tick: the world fills every robot's [`SensorFrame`](crate::messages::SensorFrame) in one iceoryx2 slice
+//! sample and publishes it, then bumps one futex word that wakes every agent with a single system call. Each
+//! agent reads its own frame from that sample (zero-copy), publishes its
+//! [`ActuatorCommand`](crate::messages::ActuatorCommand) on its robot's own command service and bumps one
+//! shared acknowledgement counter; the last one wakes the world. The world waits on that one counter until every
+//! robot is accounted for or the tick's deadline passes, then reads each robot's command from its own service,
+//! so its view never depends on arrival order. docs/transport.md explains the choices.
+//!
+//! [`WorldLink`] is the world's side, [`AgentLink`] an agent's side, [`RunSpec`] names a run and cleans it up.
+
+mod agent;
+mod futex;
+mod run;
+mod services;
+mod sync_block;
+mod world;
+
+use std::path::PathBuf;
+
+pub use agent::{AgentLink, TickFrame};
+pub use run::RunSpec;
+pub use sync_block::MAX_ROBOTS;
+pub use world::{CommandStatus, DeathNotices, LinkConfig, TickOutcome, WorldLink};
+
+/// What can go wrong in the local transport.
+#[derive(Debug, thiserror::Error)]
+pub enum TransportError {
+    /// A run name that cannot be part of a shared-memory file name.
+    #[error("invalid run name '{name}': use 1-48 ASCII letters, digits or '-'")]
+    InvalidRunName {
+        /// The rejected name.
+        name: String,
+    },
+    /// The iceoryx2 root directory must be absolute.
+    #[error("the iceoryx2 root directory {path} is not an absolute path")]
+    RootDirNotAbsolute {
+        /// The rejected path.
+        path: PathBuf,
+    },
+    /// A run must hold at least one robot and at most [`MAX_ROBOTS`].
+    #[error("a run needs 1 to {max} robots, not {robots}")]
+    RobotCount {
+        /// Requested number of robots.
+        robots: u32,
+        /// Largest supported number.
+        max: u32,
+    },
+    /// A robot index beyond the run's capacity.
+    #[error(
+        "robot {robot} cannot join: the service was created for {capacity} robots (0..{capacity})"
+    )]
+    RobotOutOfRange {
+        /// The robot index.
+        robot: u32,
+        /// Number of robots of the run.
+        capacity: u32,
+    },
+    /// Another live agent already owns this robot.
+    #[error("robot {robot} cannot join: another agent already runs it")]
+    RobotTaken {
+        /// The robot index.
+        robot: u32,
+    },
+    /// An iceoryx2 limit fixed at service creation was reached.
+    #[error(
+        "robot {robot} cannot join: the {service} service was created for {limit} {what} and all are in use \
+         (a dead agent's place is freed by the world's dead-node cleanup)"
+    )]
+    ServiceFull {
+        /// The robot index.
+        robot: u32,
+        /// Service name.
+        service: String,
+        /// The exhausted limit.
+        limit: usize,
+        /// What is limited (subscribers, publishers, nodes).
+        what: &'static str,
+    },
+    /// The sync block of the run could not be created, opened or mapped.
+    #[error("lockstep sync block {path}: {source}")]
+    SyncBlock {
+        /// Path of the block.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The sync block exists but is not what this build expects.
+    #[error("lockstep sync block {path}: {reason}")]
+    InvalidSyncBlock {
+        /// Path of the block.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A file of the run could not be removed.
+    #[error("cleaning up {path}: {source}")]
+    Cleanup {
+        /// The file or directory.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// Not every agent joined before the timeout.
+    #[error("only {joined} of {expected} agents joined within {waited_ms} ms")]
+    JoinTimeout {
+        /// Agents that joined.
+        joined: u32,
+        /// Agents expected.
+        expected: u32,
+        /// How long the world waited.
+        waited_ms: u128,
+    },
+    /// An iceoryx2 operation failed.
+    #[error("iceoryx2: {action}: {detail}")]
+    Iceoryx {
+        /// What was being done.
+        action: String,
+        /// The iceoryx2 error.
+        detail: String,
+    },
+}
+
+impl TransportError {
+    /// Wraps an iceoryx2 error with what was being done.
+    pub(crate) fn iceoryx(
+        action: impl Into<String>,
+        error: impl std::fmt::Debug,
+    ) -> TransportError {
+        TransportError::Iceoryx {
+            action: action.into(),
+            detail: format!("{error:?}"),
+        }
+    }
+}

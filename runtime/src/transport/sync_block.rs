@@ -1,0 +1,419 @@
+//! The lockstep sync block: a small file in the run's shared memory holding the futex words of the tick protocol
+//! and one slot per robot.
+//!
+//! Only control words live here (tick epoch, acknowledgement counter, join and death flags); frames and commands
+//! travel through iceoryx2 samples. The world creates the block, agents map it. Every field is an atomic, so
+//! the mapping is shared freely between threads and processes; a zero-filled block is a valid empty block.
+//!
+//! The acknowledgement word packs the tick it belongs to (top bits) with the number of robots accounted for in
+//! that tick (bottom bits). An answer is counted only while the word still carries its tick, so a late answer
+//! to an earlier tick can never be mistaken for an answer to the current one. Each robot is accounted for at
+//! most once per tick: by its agent's answer or by a death notice, whichever claims it first.
+
+use std::fs::OpenOptions;
+use std::os::fd::AsRawFd;
+use std::path::{Path, PathBuf};
+use std::ptr::NonNull;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use super::{TransportError, futex};
+
+/// Identifies a sync block file ("SWARMLCK").
+const MAGIC: u64 = 0x5357_4152_4d4c_434b;
+/// Layout version of the sync block.
+const LAYOUT_VERSION: u32 = 1;
+/// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
+const COUNT_BITS: u32 = 20;
+/// Mask of the count bits.
+const COUNT_MASK: u32 = (1 << COUNT_BITS) - 1;
+/// Most robots one run can hold (the count field must not overflow into the tick tag).
+pub const MAX_ROBOTS: u32 = COUNT_MASK;
+
+/// One 32-bit word on its own cache line, so that agents polling it do not share a line with writers of others.
+#[repr(C, align(64))]
+struct Line32(AtomicU32);
+
+/// Fixed part of the block.
+#[repr(C)]
+struct Header {
+    magic: AtomicU64,
+    version: AtomicU32,
+    capacity: AtomicU32,
+    /// Current tick (full width), written before `epoch`.
+    tick: AtomicU64,
+    /// Low 32 bits of the current tick; agents sleep on it.
+    epoch: Line32,
+    /// Tick tag and answer count; the world sleeps on it.
+    acks: Line32,
+    /// Number of robots whose agent has joined; the world sleeps on it while waiting for agents.
+    joined: Line32,
+    /// Non-zero once the world ends the run.
+    stop: Line32,
+}
+
+/// Per-robot control words.
+#[repr(C)]
+struct RobotSlot {
+    /// Last tick this robot was accounted for.
+    answered: AtomicU64,
+    /// 1 while an agent owns this robot.
+    owner: AtomicU32,
+    /// 1 after a death notice, until a replacement agent joins.
+    dead: AtomicU32,
+}
+
+/// A mapping of a run's sync block.
+pub(crate) struct SyncBlock {
+    base: NonNull<u8>,
+    len: usize,
+    capacity: u32,
+}
+
+// SAFETY: the mapping is only accessed through atomics, and it stays mapped until the SyncBlock is dropped.
+unsafe impl Send for SyncBlock {}
+// SAFETY: as above; every access is an atomic operation.
+unsafe impl Sync for SyncBlock {}
+
+/// Whether a robot could be claimed by a new agent.
+pub(crate) enum JoinClaim {
+    /// The robot is now owned by the caller.
+    Claimed,
+    /// Another live agent already owns the robot.
+    Taken,
+}
+
+impl SyncBlock {
+    fn size_for(capacity: u32) -> usize {
+        size_of::<Header>() + capacity as usize * size_of::<RobotSlot>()
+    }
+
+    /// Creates the block of a run for `capacity` robots; fails if it exists.
+    pub(crate) fn create(path: &Path, capacity: u32) -> Result<SyncBlock, TransportError> {
+        let io_err = |source| TransportError::SyncBlock {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .map_err(io_err)?;
+        let len = Self::size_for(capacity);
+        file.set_len(len as u64).map_err(io_err)?;
+        let block = Self::map(path, &file, len, capacity)?;
+        let header = block.header();
+        header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
+        header.capacity.store(capacity, Ordering::Relaxed);
+        header.magic.store(MAGIC, Ordering::Release);
+        Ok(block)
+    }
+
+    /// Maps the existing block of a run.
+    pub(crate) fn open(path: &Path) -> Result<SyncBlock, TransportError> {
+        let file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|source| TransportError::SyncBlock {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let invalid = |reason: String| TransportError::InvalidSyncBlock {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let file_len = file
+            .metadata()
+            .map_err(|source| TransportError::SyncBlock {
+                path: path.to_path_buf(),
+                source,
+            })?
+            .len();
+        if file_len < size_of::<Header>() as u64 {
+            return Err(invalid(format!(
+                "{file_len} bytes is too short for a header"
+            )));
+        }
+        let header_only = Self::map(path, &file, size_of::<Header>(), 0)?;
+        let header = header_only.header();
+        if header.magic.load(Ordering::Acquire) != MAGIC {
+            return Err(invalid("not a swarm lockstep block (bad magic)".into()));
+        }
+        let version = header.version.load(Ordering::Relaxed);
+        if version != LAYOUT_VERSION {
+            return Err(invalid(format!(
+                "layout version {version}, this build speaks {LAYOUT_VERSION}"
+            )));
+        }
+        let capacity = header.capacity.load(Ordering::Relaxed);
+        let len = Self::size_for(capacity);
+        if file_len < len as u64 {
+            return Err(invalid(format!(
+                "{file_len} bytes cannot hold {capacity} robots ({len} bytes)"
+            )));
+        }
+        drop(header_only);
+        Self::map(path, &file, len, capacity)
+    }
+
+    fn map(
+        path: &Path,
+        file: &std::fs::File,
+        len: usize,
+        capacity: u32,
+    ) -> Result<SyncBlock, TransportError> {
+        // SAFETY: a fresh shared mapping of an open file descriptor; the kernel picks the address.
+        let ptr = unsafe {
+            libc::mmap(
+                std::ptr::null_mut(),
+                len,
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_SHARED,
+                file.as_raw_fd(),
+                0,
+            )
+        };
+        if ptr == libc::MAP_FAILED {
+            return Err(TransportError::SyncBlock {
+                path: PathBuf::from(path),
+                source: std::io::Error::last_os_error(),
+            });
+        }
+        let base = NonNull::new(ptr.cast::<u8>()).ok_or_else(|| TransportError::SyncBlock {
+            path: PathBuf::from(path),
+            source: std::io::Error::other("mmap returned null"),
+        })?;
+        Ok(SyncBlock {
+            base,
+            len,
+            capacity,
+        })
+    }
+
+    fn header(&self) -> &Header {
+        // SAFETY: the mapping is at least one page-aligned header long and zero or validly initialised.
+        unsafe { &*self.base.as_ptr().cast::<Header>() }
+    }
+
+    fn slot(&self, robot: u32) -> &RobotSlot {
+        debug_assert!(robot < self.capacity);
+        // SAFETY: robot < capacity, and the mapping holds `capacity` slots after the header.
+        unsafe {
+            &*self
+                .base
+                .as_ptr()
+                .add(size_of::<Header>())
+                .cast::<RobotSlot>()
+                .add(robot as usize)
+        }
+    }
+
+    /// Number of robots the block was created for.
+    pub(crate) fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// The current tick.
+    pub(crate) fn tick(&self) -> u64 {
+        self.header().tick.load(Ordering::Acquire)
+    }
+
+    /// The current epoch word (low 32 bits of the tick).
+    pub(crate) fn epoch(&self) -> u32 {
+        self.header().epoch.0.load(Ordering::Acquire)
+    }
+
+    /// Whether the world has ended the run.
+    pub(crate) fn stopped(&self) -> bool {
+        self.header().stop.0.load(Ordering::Acquire) != 0
+    }
+
+    /// Opens tick `tick` for answers: resets the count, then accounts for every robot with a death notice.
+    pub(crate) fn open_tick(&self, tick: u64) {
+        let header = self.header();
+        header
+            .acks
+            .0
+            .store(tag(tick) << COUNT_BITS, Ordering::Release);
+        // SeqCst pairs with `mark_dead`: either this scan sees the notice or the notice sees this tick.
+        header.tick.store(tick, Ordering::SeqCst);
+        for robot in 0..self.capacity {
+            if self.slot(robot).dead.load(Ordering::SeqCst) != 0 {
+                self.claim(robot, tick);
+            }
+        }
+    }
+
+    /// Publishes the tick to the agents and wakes all of them with one system call.
+    pub(crate) fn wake_agents(&self, tick: u64) {
+        let epoch = &self.header().epoch.0;
+        epoch.store(tick as u32, Ordering::Release);
+        futex::wake(epoch, i32::MAX);
+    }
+
+    /// Ends the run: agents waiting for a tick return.
+    pub(crate) fn stop(&self) {
+        let header = self.header();
+        header.stop.0.store(1, Ordering::Release);
+        header.epoch.0.fetch_add(1, Ordering::AcqRel);
+        futex::wake(&header.epoch.0, i32::MAX);
+    }
+
+    /// Accounts for `robot` in `tick` unless it already was; returns whether this call counted it. The call
+    /// that completes the count wakes the world.
+    pub(crate) fn claim(&self, robot: u32, tick: u64) -> bool {
+        if self.slot(robot).answered.swap(tick, Ordering::AcqRel) == tick {
+            return false;
+        }
+        let acks = &self.header().acks.0;
+        let mut current = acks.load(Ordering::Acquire);
+        loop {
+            if current >> COUNT_BITS != tag(tick) {
+                return false;
+            }
+            match acks.compare_exchange_weak(
+                current,
+                current + 1,
+                Ordering::AcqRel,
+                Ordering::Acquire,
+            ) {
+                Ok(_) => {
+                    if (current & COUNT_MASK) + 1 == self.capacity {
+                        futex::wake(acks, 1);
+                    }
+                    return true;
+                }
+                Err(seen) => current = seen,
+            }
+        }
+    }
+
+    /// Waits until every robot is accounted for in `tick` or `deadline` passes, spinning for at most `spin`
+    /// first. Returns whether every robot was accounted for.
+    pub(crate) fn wait_answers(&self, tick: u64, spin: Duration, deadline: Instant) -> bool {
+        let acks = &self.header().acks.0;
+        let complete = tag(tick) << COUNT_BITS | self.capacity;
+        let spin_until = Instant::now() + spin;
+        loop {
+            let current = acks.load(Ordering::Acquire);
+            if current == complete {
+                return true;
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return false;
+            }
+            if now < spin_until {
+                std::hint::spin_loop();
+            } else {
+                futex::wait(acks, current, Some(deadline - now));
+            }
+        }
+    }
+
+    /// Death notice: `robot` is accounted for in the current tick and every later one until an agent rejoins
+    /// for it, and its ownership is released so that a replacement agent may join.
+    pub(crate) fn mark_dead(&self, robot: u32) {
+        let slot = self.slot(robot);
+        slot.dead.store(1, Ordering::SeqCst);
+        if slot.owner.swap(0, Ordering::AcqRel) == 1 {
+            self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
+        }
+        self.claim(robot, self.header().tick.load(Ordering::SeqCst));
+    }
+
+    /// Whether `robot` has a death notice and no replacement yet.
+    pub(crate) fn is_dead(&self, robot: u32) -> bool {
+        self.slot(robot).dead.load(Ordering::Acquire) != 0
+    }
+
+    /// An agent claims `robot` before it connects, so that a second agent for the same robot fails fast.
+    pub(crate) fn claim_robot(&self, robot: u32) -> JoinClaim {
+        match self
+            .slot(robot)
+            .owner
+            .compare_exchange(0, 1, Ordering::AcqRel, Ordering::Acquire)
+        {
+            Ok(_) => JoinClaim::Claimed,
+            Err(_) => JoinClaim::Taken,
+        }
+    }
+
+    /// The agent of `robot` is connected: its death notice (if any) is cleared, so ticks wait for it again, and
+    /// a world waiting for joins is woken.
+    pub(crate) fn announce_ready(&self, robot: u32) {
+        self.slot(robot).dead.store(0, Ordering::SeqCst);
+        let joined = &self.header().joined.0;
+        joined.fetch_add(1, Ordering::AcqRel);
+        futex::wake(joined, 1);
+    }
+
+    /// An agent that claimed `robot` but could not connect gives it back.
+    pub(crate) fn release_claim(&self, robot: u32) {
+        self.slot(robot).owner.store(0, Ordering::Release);
+    }
+
+    /// An agent leaving cleanly gives its robot back.
+    pub(crate) fn leave(&self, robot: u32) {
+        let slot = self.slot(robot);
+        if slot
+            .owner
+            .compare_exchange(1, 0, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+        {
+            self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
+        }
+    }
+
+    /// Waits until `count` agents have joined or `deadline` passes; returns the number joined.
+    pub(crate) fn wait_joined(&self, count: u32, deadline: Instant) -> u32 {
+        let joined = &self.header().joined.0;
+        loop {
+            let current = joined.load(Ordering::Acquire);
+            let now = Instant::now();
+            if current >= count || now >= deadline {
+                return current;
+            }
+            futex::wait(
+                joined,
+                current,
+                Some((deadline - now).min(Duration::from_millis(100))),
+            );
+        }
+    }
+
+    /// Waits until the epoch word differs from `seen` (or the run stops), spinning `spin` times before blocking.
+    pub(crate) fn wait_epoch_change(&self, seen: u32, spin: u32) -> u32 {
+        let epoch = &self.header().epoch.0;
+        for _ in 0..spin {
+            let current = epoch.load(Ordering::Acquire);
+            if current != seen {
+                return current;
+            }
+            std::hint::spin_loop();
+        }
+        loop {
+            let current = epoch.load(Ordering::Acquire);
+            if current != seen {
+                return current;
+            }
+            futex::wait(epoch, seen, None);
+        }
+    }
+}
+
+impl Drop for SyncBlock {
+    fn drop(&mut self) {
+        // SAFETY: base/len are exactly what mmap returned; nothing borrows the mapping past its owner.
+        unsafe {
+            libc::munmap(self.base.as_ptr().cast(), self.len);
+        }
+    }
+}
+
+/// The tick tag stored in the acknowledgement word.
+fn tag(tick: u64) -> u32 {
+    (tick as u32) & (u32::MAX >> COUNT_BITS)
+}

@@ -1,0 +1,225 @@
+//! System tests of the lockstep transport with real agent processes and real iceoryx2 shared memory.
+
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use swarm_runtime::transport::{
+    AgentLink, CommandStatus, LinkConfig, RunSpec, TransportError, WorldLink,
+};
+
+const AGENT: &str = env!("CARGO_BIN_EXE_swarm-lockstep-agent");
+/// Generous: agents of a loaded CI machine may take seconds to start.
+const JOIN_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// Owns a run's agent processes and files: kills the children and removes every file even when a test fails.
+struct Run {
+    spec: RunSpec,
+    children: Vec<Child>,
+}
+
+impl Run {
+    fn new() -> Run {
+        Run {
+            spec: RunSpec::unique(),
+            children: Vec::new(),
+        }
+    }
+
+    fn spawn(&mut self, robot: u32, extra: &[&str]) {
+        let child = Command::new(AGENT)
+            .arg("--run")
+            .arg(self.spec.name())
+            .arg("--root")
+            .arg(self.spec.root_dir())
+            .arg("--robot")
+            .arg(robot.to_string())
+            .args(extra)
+            .stdin(Stdio::null())
+            .spawn()
+            .expect("spawn the lockstep agent");
+        self.children.push(child);
+    }
+
+    fn kill_all(&mut self) {
+        for child in &mut self.children {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        self.children.clear();
+    }
+}
+
+impl Drop for Run {
+    fn drop(&mut self) {
+        self.kill_all();
+        let _ = self.spec.cleanup();
+    }
+}
+
+/// The world writes a per-robot, per-tick marker into each frame; the agent echoes it as its wheel speeds.
+fn sense(tick: u64, frames: &mut [swarm_runtime::messages::SensorFrame]) {
+    for (robot, frame) in frames.iter_mut().enumerate() {
+        frame.position = [robot as f32 * 10.0 + 1.0, tick as f32];
+    }
+}
+
+fn expect_echo(world: &WorldLink, robot: u32, tick: u64) {
+    let command = world
+        .command(robot)
+        .unwrap_or_else(|| panic!("robot {robot} has no command in tick {tick}"));
+    assert_eq!(command.robot, robot);
+    assert_eq!(command.tick, tick);
+    assert_eq!(command.wheels, [robot as f32 * 10.0 + 1.0, tick as f32]);
+}
+
+fn config(robots: u32, deadline_ms: u64) -> LinkConfig {
+    let mut config = LinkConfig::new(robots);
+    config.tick_deadline = Duration::from_millis(deadline_ms);
+    config
+}
+
+#[test]
+fn every_agent_receives_its_own_frame_and_answers_into_its_own_slot() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(8, 10_000)).expect("create world");
+    for robot in 0..8 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    for tick in 1..=30 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!(outcome.tick, tick);
+        assert_eq!(outcome.answered, 8, "tick {tick}: {outcome:?}");
+        for robot in 0..8 {
+            expect_echo(&world, robot, tick);
+        }
+    }
+}
+
+#[test]
+fn killed_agent_does_not_block_the_tick_and_is_reported_missing_then_dead() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(4, 300)).expect("create world");
+    for robot in 0..4 {
+        let extra: &[&str] = if robot == 2 { &["--die-at", "3"] } else { &[] };
+        run.spawn(robot, extra);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    for _ in 1..=2 {
+        assert_eq!(world.tick_with(sense).expect("tick").answered, 4);
+    }
+    // Tick 3: robot 2 aborts on reading its frame; the deadline ends the tick.
+    let outcome = world.tick_with(sense).expect("tick 3");
+    assert_eq!((outcome.answered, outcome.missing, outcome.dead), (3, 1, 0));
+    assert_eq!(world.statuses()[2], CommandStatus::Missing);
+    assert!(world.command(2).is_none());
+    for robot in [0, 1, 3] {
+        expect_echo(&world, robot, 3);
+    }
+    // The launcher's death notice: later ticks no longer wait for robot 2.
+    world.mark_dead(2).expect("death notice");
+    for tick in 4..=6 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!((outcome.answered, outcome.missing, outcome.dead), (3, 0, 1));
+        assert_eq!(world.statuses()[2], CommandStatus::Dead);
+        for robot in [0, 1, 3] {
+            expect_echo(&world, robot, tick);
+        }
+    }
+}
+
+#[test]
+fn death_notice_from_another_thread_releases_the_waiting_tick() {
+    let mut run = Run::new();
+    // A deadline far beyond the test's patience: only the death notice can end tick 2.
+    let mut world = WorldLink::create(&run.spec, config(2, 600_000)).expect("create world");
+    run.spawn(0, &[]);
+    run.spawn(1, &["--freeze-at", "2"]);
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 2);
+    let notices = world.death_notices();
+    let (started_tx, started_rx) = std::sync::mpsc::channel();
+    let launcher = std::thread::spawn(move || {
+        // Wait until the world is inside tick 2, then report robot 1 dead as a launcher would.
+        started_rx.recv().expect("tick 2 started");
+        notices.mark_dead(1).expect("death notice");
+    });
+    let outcome = world
+        .tick_with(|tick, frames| {
+            sense(tick, frames);
+            started_tx.send(()).expect("notify");
+        })
+        .expect("tick 2");
+    launcher.join().expect("launcher thread");
+    assert_eq!((outcome.answered, outcome.dead), (1, 1));
+    expect_echo(&world, 0, 2);
+}
+
+#[test]
+fn frozen_agent_misses_the_deadline_while_the_others_keep_ticking() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(3, 200)).expect("create world");
+    run.spawn(0, &[]);
+    run.spawn(1, &["--freeze-at", "2"]);
+    run.spawn(2, &[]);
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 3);
+    for tick in 2..=4 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!((outcome.answered, outcome.missing), (2, 1));
+        assert_eq!(world.statuses()[1], CommandStatus::Missing);
+        expect_echo(&world, 0, tick);
+        expect_echo(&world, 2, tick);
+    }
+}
+
+#[test]
+fn robot_beyond_the_run_cannot_join_and_the_error_names_the_limit() {
+    let run = Run::new();
+    let _world = WorldLink::create(&run.spec, config(4, 100)).expect("create world");
+    let error = AgentLink::join(&run.spec, 4)
+        .err()
+        .expect("robot 4 must be rejected");
+    assert!(matches!(
+        error,
+        TransportError::RobotOutOfRange {
+            robot: 4,
+            capacity: 4
+        }
+    ));
+    assert_eq!(
+        error.to_string(),
+        "robot 4 cannot join: the service was created for 4 robots (0..4)"
+    );
+}
+
+#[test]
+fn second_agent_for_the_same_robot_is_rejected() {
+    let run = Run::new();
+    let _world = WorldLink::create(&run.spec, config(2, 100)).expect("create world");
+    let _first = AgentLink::join(&run.spec, 1).expect("first agent joins");
+    let error = AgentLink::join(&run.spec, 1)
+        .err()
+        .expect("second agent must be rejected");
+    assert!(matches!(error, TransportError::RobotTaken { robot: 1 }));
+}
+
+#[test]
+fn cleanup_after_sigkill_of_every_process_leaves_nothing_in_dev_shm() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(3, 10_000)).expect("create world");
+    for robot in 0..3 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick").answered, 3);
+    // Everyone dies without running a destructor: agents by SIGKILL, the world by forgetting its link.
+    run.kill_all();
+    std::mem::forget(world);
+    assert!(
+        !run.spec.leftovers().is_empty(),
+        "a live run must have files to clean up"
+    );
+    run.spec.cleanup().expect("cleanup");
+    assert_eq!(run.spec.leftovers(), Vec::<std::path::PathBuf>::new());
+}
