@@ -7,12 +7,11 @@
 
 use std::fmt;
 
+use supervisor_gen::compiled::CompiledEvent;
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_runtime::player::EventCallbacks;
 use thiserror::Error;
 
-use supervisor_gen::compiled::CompiledEvent;
-
-use crate::contract::EventCallbacks;
 use crate::profile::{Procedure, Profile};
 
 /// Why a profile does not fit a supervisor set; lists every mismatch at once.

@@ -4,7 +4,8 @@
 //! the profile's callbacks (one error listing all mismatches), or builds the native controller. Every failure here
 //! happens at startup, so the agent can exit non-zero with the reason before tick 1.
 
-use supervisor_gen::compiled::SupervisorSet;
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_runtime::player::{Player, PlayerError};
 use thiserror::Error;
 use tracing::info;
 
@@ -18,8 +19,8 @@ use crate::supervisors::{self, SupervisorError};
 pub enum Control {
     /// Supervisors and the profile callbacks bound to their events.
     Supervised {
-        /// The supervisor set.
-        set: SupervisorSet,
+        /// The player executing the robot's supervisor set.
+        player: Box<Player>,
         /// The bound callbacks.
         callbacks: BoxedCallbacks,
     },
@@ -41,13 +42,41 @@ pub enum BuildError {
     /// The profile could not be set up or bound.
     #[error(transparent)]
     Profile(#[from] ProfileError),
+    /// The player refused the supervisor set.
+    #[error("supervisors {where_}: {problem}")]
+    Player {
+        /// Where they were loaded from.
+        where_: String,
+        /// What the player refused.
+        problem: PlayerError,
+    },
     /// The native controller could not be built.
     #[error(transparent)]
     Native(#[from] NativeError),
 }
 
-/// Loads, binds and checks everything `plan` needs, with parameters from `params`.
-pub fn build(plan: &Plan, params: &Params) -> Result<Control, BuildError> {
+impl Control {
+    /// One control step: the player's step with the bound callbacks, or the native controller's step. `command`
+    /// carries the actuator state over from the previous tick; allocates nothing.
+    pub fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {
+        match self {
+            Control::Supervised { player, callbacks } => player.step(frame, callbacks, command),
+            Control::Native(native) => {
+                command.events_len = 0;
+                native.step(frame, command);
+            }
+        }
+    }
+}
+
+/// Loads, binds and checks everything `plan` needs, with parameters from `params`, for robot `robot` of a run
+/// seeded with `run_seed` (the player's random stream).
+pub fn build(
+    plan: &Plan,
+    params: &Params,
+    run_seed: u64,
+    robot: u32,
+) -> Result<Control, BuildError> {
     match plan {
         Plan::Supervised {
             profile,
@@ -70,7 +99,15 @@ pub fn build(plan: &Plan, params: &Params) -> Result<Control, BuildError> {
                 events = set.events.len(),
                 "supervised controller bound"
             );
-            Ok(Control::Supervised { set, callbacks })
+            let player =
+                Player::new(set, run_seed, robot).map_err(|problem| BuildError::Player {
+                    where_: where_.clone(),
+                    problem,
+                })?;
+            Ok(Control::Supervised {
+                player: Box::new(player),
+                callbacks,
+            })
         }
         Plan::Native { name } => {
             let controller = native::build_native(name, params)?;
@@ -92,7 +129,7 @@ mod tests {
             supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
         };
         assert!(matches!(
-            build(&plan, &Params::default()),
+            build(&plan, &Params::default(), 1, 0),
             Ok(Control::Supervised { .. })
         ));
     }
@@ -103,7 +140,7 @@ mod tests {
             profile: "obstacle_avoidance_sct".to_owned(),
             supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
         };
-        let err = build(&plan, &Params::default()).err().unwrap();
+        let err = build(&plan, &Params::default(), 1, 0).err().unwrap();
         assert!(matches!(err, BuildError::Profile(ProfileError::Bind(_))));
     }
 
@@ -113,7 +150,10 @@ mod tests {
             profile: "obstacle_avoidance".to_owned(),
             supervisors: Supervisors::Path("/nonexistent/oa.sup".into()),
         };
-        let err = build(&plan, &Params::default()).err().unwrap().to_string();
+        let err = build(&plan, &Params::default(), 1, 0)
+            .err()
+            .unwrap()
+            .to_string();
         assert!(
             err.starts_with("supervisors /nonexistent/oa.sup: "),
             "{err}"
@@ -126,7 +166,7 @@ mod tests {
             name: "epuck_obstacleavoidance".to_owned(),
         };
         assert!(matches!(
-            build(&plan, &Params::default()),
+            build(&plan, &Params::default(), 1, 0),
             Ok(Control::Native(_))
         ));
     }

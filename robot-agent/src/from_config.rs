@@ -56,10 +56,13 @@ pub fn params_of(controller: &Controller) -> Params {
     )
 }
 
-/// Plans and builds `controller` of `experiment`; any failure is located at its `<params>` element.
+/// Plans and builds `controller` of `experiment` for robot `robot` of a run seeded with `run_seed`; any failure
+/// is located at the controller's `<params>` element.
 pub fn build(
     experiment: &Experiment,
     controller: &Controller,
+    run_seed: u64,
+    robot: u32,
 ) -> Result<(Plan, Control), Diagnostic> {
     let params = params_of(controller);
     let located = |message: String| {
@@ -73,7 +76,8 @@ pub fn build(
     };
     let plan = controller::plan(&controller.tag, &params, experiment.base_dir())
         .map_err(|e| located(e.to_string()))?;
-    let control = control::build(&plan, &params).map_err(|e| located(e.to_string()))?;
+    let control =
+        control::build(&plan, &params, run_seed, robot).map_err(|e| located(e.to_string()))?;
     Ok((plan, control))
 }
 
@@ -145,7 +149,7 @@ mod tests {
     #[test]
     fn thesis_controller_builds_from_the_config() {
         let e = experiment();
-        let (plan, _) = build(&e, choose(&e, Some("fdc")).unwrap()).unwrap();
+        let (plan, _) = build(&e, choose(&e, Some("fdc")).unwrap(), 1, 0).unwrap();
         assert_eq!(
             plan.to_string(),
             "profile `obstacle_avoidance` with supervisors built-in obstacle_avoidance/ptsct"
@@ -155,7 +159,7 @@ mod tests {
     #[test]
     fn bad_param_is_located_at_the_params_element() {
         let e = experiment();
-        let err = build(&e, choose(&e, Some("argos")).unwrap())
+        let err = build(&e, choose(&e, Some("argos")).unwrap(), 1, 0)
             .err()
             .unwrap()
             .to_string();

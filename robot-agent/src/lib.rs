@@ -6,7 +6,6 @@
 //! depends on the world.
 
 pub mod binding;
-pub mod contract;
 pub mod control;
 pub mod controller;
 pub mod from_config;

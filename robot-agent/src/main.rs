@@ -1,6 +1,7 @@
 //! `robot-agent`: one robot's process. Loads and checks its controller before the first tick, so every startup
 //! failure (unknown controller or profile, bad supervisor file, unbound event, bad parameter) exits non-zero with
-//! the reason for the launcher to report.
+//! the reason for the launcher to report; then joins the run and answers every tick: wait for the frame, step
+//! the controller, send the command.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -12,18 +13,27 @@ use robot_agent::controller;
 use robot_agent::from_config;
 use robot_agent::params::Params;
 use swarm_runtime::config::Experiment;
+use swarm_runtime::messages::ActuatorCommand;
+use swarm_runtime::transport::{AgentLink, RunSpec};
 use tracing::{debug, info};
 
 /// One robot of a swarm run.
 #[derive(Debug, Parser)]
 #[command(name = "robot-agent", version)]
 struct Args {
-    /// Run id: names the run's shared-memory services.
+    /// Run name (shared by every process of the run).
     #[arg(long)]
     run: String,
+    /// iceoryx2 root directory of the run (absolute).
+    #[arg(long, required_unless_present = "check")]
+    root: Option<PathBuf>,
     /// Index of this robot in the run (0..N).
     #[arg(long)]
     robot: u32,
+    /// Run seed; the player's random stream is derived from it and the robot index. Default: the
+    /// configuration's `random_seed`, or 0 without --config.
+    #[arg(long)]
+    seed: Option<u64>,
     /// Experiment configuration (.argos); the robot runs the controller named by --controller.
     #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
     config: Option<PathBuf>,
@@ -63,9 +73,19 @@ fn build_control(args: &Args) -> Result<Control> {
         for w in &warnings {
             debug!("{w}");
         }
+        let seed = match (args.seed, experiment.framework.random_seed) {
+            (Some(seed), _) | (None, Some(seed)) => seed,
+            (None, None) => anyhow::bail!(
+                "{}: random_seed is left to the clock; pass the run's seed with --seed",
+                path.display()
+            ),
+        };
         let controller = from_config::choose(&experiment, args.controller.as_deref())?;
-        let (plan, control) = from_config::build(&experiment, controller)?;
-        info!(controller = controller.id.as_str(), "robot runs {plan}");
+        let (plan, control) = from_config::build(&experiment, controller, seed, args.robot)?;
+        info!(
+            controller = controller.id.as_str(),
+            seed, "robot runs {plan}"
+        );
         return Ok(control);
     }
     let mut pairs = args.params.clone();
@@ -76,26 +96,40 @@ fn build_control(args: &Args) -> Result<Control> {
     let params = Params::new(pairs);
     let base_dir = std::env::current_dir().context("cannot resolve relative paths")?;
     let plan = controller::plan(&args.element, &params, &base_dir)?;
-    let control = control::build(&plan, &params)?;
-    info!("robot runs {plan}");
+    let seed = args.seed.unwrap_or(0);
+    let control = control::build(&plan, &params, seed, args.robot)?;
+    info!(seed, "robot runs {plan}");
     Ok(control)
 }
 
-fn run(args: Args) -> Result<()> {
-    let _control = build_control(&args)
-        .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
+/// Answers every tick of the run until the world ends it.
+fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<()> {
+    let run = RunSpec::new(&args.run, root)?;
+    let mut link = AgentLink::join(&run, args.robot)?;
     info!(
         run = args.run.as_str(),
         robot = args.robot,
-        "controller ready"
+        "joined the run"
     );
-    if args.check {
-        return Ok(());
+    // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
+    let mut command = ActuatorCommand::idle(args.robot, 0);
+    while let Some(tick) = link.next_tick().context("waiting for a tick")? {
+        control.step(tick.frame(), &mut command);
+        link.answer(tick, &command).context("answering a tick")?;
     }
-    anyhow::bail!(
-        "robot {}: joining a run needs the transport, which this build does not have yet",
-        args.robot
-    )
+    info!(robot = args.robot, "the world ended the run");
+    Ok(())
+}
+
+fn run(args: &Args) -> Result<()> {
+    let mut control = build_control(args)
+        .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
+    let Some(root) = args.root.as_deref().filter(|_| !args.check) else {
+        info!(robot = args.robot, "controller checked");
+        return Ok(());
+    };
+    serve(args, root, &mut control)
+        .with_context(|| format!("robot {} in run {}", args.robot, args.run))
 }
 
 fn main() -> ExitCode {
@@ -106,7 +140,7 @@ fn main() -> ExitCode {
         )
         .with_writer(std::io::stderr)
         .init();
-    match run(Args::parse()) {
+    match run(&Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");

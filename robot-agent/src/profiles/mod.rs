@@ -5,19 +5,29 @@
 pub mod obstacle_avoidance;
 pub mod timer;
 
+use supervisor_gen::compiled::CompiledEvent;
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_runtime::player::EventCallbacks;
 use thiserror::Error;
 
 use crate::binding::{BindError, bind};
-use supervisor_gen::compiled::CompiledEvent;
-
-use crate::contract::EventCallbacks;
 use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
 
-/// Callbacks of a bound profile, ready for the player.
-pub type BoxedCallbacks = Box<dyn EventCallbacks + Send>;
+/// Callbacks of a bound profile, whatever its memory type, ready for the player.
+pub struct BoxedCallbacks(Box<dyn EventCallbacks + Send>);
+
+impl EventCallbacks for BoxedCallbacks {
+    fn check(&mut self, event: u8, frame: &SensorFrame) -> bool {
+        self.0.check(event, frame)
+    }
+
+    fn act(&mut self, event: u8, frame: &SensorFrame, command: &mut ActuatorCommand) {
+        self.0.act(event, frame, command);
+    }
+}
 
 type BindFn = fn(&Params, &[CompiledEvent]) -> Result<BoxedCallbacks, ProfileError>;
 
@@ -87,7 +97,7 @@ fn bind_boxed<P: Profile>(
         profile: P::NAME,
         problem,
     })?;
-    Ok(Box::new(bind(state, events)?))
+    Ok(BoxedCallbacks(Box::new(bind(state, events)?)))
 }
 
 #[cfg(test)]
