@@ -50,6 +50,12 @@ fn thesis_example_loads_with_section_5_values() {
     assert_eq!(c.sensors[0].kind, DeviceKind::Proximity);
     assert_eq!(c.sensors[0].name, "epuck_proximity");
     assert_eq!(c.params.get("velocity"), Some("12.8"));
+    assert_eq!(
+        c.profile(),
+        None,
+        "the thesis names no profile: the agent maps the controller tag"
+    );
+    assert!(c.supervisors().is_empty());
     assert_eq!(c.params.parse::<f64>("velocity"), Ok(Some(12.8)));
 
     assert_eq!(exp.arena.size, Vec3::new(3.0, 3.0, 1.0));
@@ -130,6 +136,25 @@ fn arena_items_come_back_in_file_order() {
         })
         .collect();
     assert_eq!(lines, [25, 26, 27, 28, 30, 41, 51]);
+}
+
+#[test]
+fn robots_are_numbered_in_file_order_with_generated_ids() {
+    let (exp, _) = load("configs/obstacle_avoidance/thesis_example.argos");
+    let robots = exp.arena.robots();
+    assert_eq!(robots.len(), 40);
+    assert_eq!((robots[0].index, robots[0].id.as_str()), (0, "fb0"));
+    assert_eq!((robots[39].index, robots[39].id.as_str()), (39, "fb39"));
+    assert!(robots.iter().all(|r| r.epuck.controller == "fdc"));
+
+    let (grid, _) = load("runtime/tests/fixtures/good/grid_and_rab.argos");
+    let ids: Vec<String> = grid.arena.robots().into_iter().map(|r| r.id).collect();
+    assert_eq!(
+        ids.first().map(String::as_str),
+        Some("r100"),
+        "base_num 100"
+    );
+    assert_eq!(ids.last().map(String::as_str), Some("r111"));
 }
 
 #[test]
@@ -363,4 +388,108 @@ fn grid_fixture_reads_core_names_rab_and_grid() {
         exp.arena.distributions[1].template,
         Entity::Light(_)
     ));
+}
+
+#[test]
+fn tasks_4_15_sketch_loads_unchanged() {
+    let (exp, warnings) = load("runtime/tests/fixtures/good/tasks_4_15_sketch.argos");
+    assert!(warnings.is_empty(), "{:?}", messages(&warnings));
+    assert!(matches!(
+        exp.arena.floor.as_ref().map(|f| &f.source),
+        Some(FloorSource::LoopFunctions)
+    ));
+    match &exp.arena.distributions[1].template {
+        Entity::Cylinder(food) => {
+            let leds = food.leds.as_ref().expect("food carries an LED");
+            assert_eq!(leds.leds[0].offset, Vec3::new(0.0, 0.0, 0.06));
+            assert_eq!(leds.leds[0].color, Rgb { r: 255, g: 0, b: 0 });
+        }
+        other => panic!("food cylinders expected, got {other:?}"),
+    }
+}
+
+#[test]
+fn shipped_foraging_config_has_the_section_4_9_world() {
+    let (exp, warnings) = load("configs/foraging/foraging.argos");
+    assert!(warnings.is_empty(), "{:?}", messages(&warnings));
+    assert_eq!(exp.framework.ticks_per_second, 20);
+    assert_eq!(
+        exp.framework.max_ticks(),
+        Some(144_000),
+        "2 h cap at 20 ticks/s"
+    );
+    let c = exp.controller("fc").expect("controller fc");
+    assert_eq!(c.profile(), Some("foraging"));
+    for kind in [DeviceKind::Proximity, DeviceKind::Light, DeviceKind::Ground] {
+        assert_eq!(
+            c.sensor(kind).map(|d| d.noise_level),
+            Some(0.02),
+            "{kind:?}"
+        );
+    }
+    let lights: Vec<Vec3> = exp
+        .arena
+        .entities
+        .iter()
+        .filter(|p| matches!(p.entity, Entity::Light(_)))
+        .map(|p| p.pose.position)
+        .collect();
+    assert_eq!(
+        lights,
+        [-3.75, -1.25, 1.25, 3.75].map(|x| Vec3::new(x, -3.5, 1.0)),
+        "four home lights at 1 m"
+    );
+    match &exp.arena.floor.as_ref().expect("floor").source {
+        FloorSource::Regions { regions, .. } => {
+            assert_eq!(
+                (regions[0].min.y, regions[0].max.y),
+                (-5.1, -2.0),
+                "home strip up to y = -2"
+            );
+            assert_eq!(regions[0].color, Rgb { r: 0, g: 0, b: 0 });
+        }
+        other => panic!("regions floor expected, got {other:?}"),
+    }
+    let d = &exp.arena.distributions;
+    let quantities: Vec<u32> = d.iter().map(|d| d.quantity).collect();
+    assert_eq!(quantities, [40, 40, 10, 10]);
+    assert!(matches!(d[1].template, Entity::Target(_)));
+    match &d[0].position {
+        PositionMethod::Uniform { max, .. } => assert!(max.y < -2.0, "robots start in home"),
+        other => panic!("uniform robots expected, got {other:?}"),
+    }
+}
+
+#[test]
+fn hand_placed_robots_take_their_place_in_file_order() {
+    let text = r#"<argos-configuration>
+  <framework><experiment ticks_per_second="10" random_seed="3"/></framework>
+  <controllers><c id="k"/></controllers>
+  <arena size="4,4,1">
+    <e-puck id="first"><body position="0,0,0"/><controller config="k"/></e-puck>
+    <distribute>
+      <position method="uniform" min="-1,-1,0" max="1,1,0"/>
+      <orientation method="constant" values="0,0,0"/>
+      <entity quantity="2" max_trials="10"><e-puck id="d"><controller config="k"/></e-puck></entity>
+    </distribute>
+    <e-puck id="last"><body position="1,1,0"/><controller config="k"/></e-puck>
+  </arena>
+  <physics_engines><dynamics2d id="p"/></physics_engines>
+</argos-configuration>"#;
+    let (exp, _) = Experiment::parse("mixed.argos", text).expect("valid");
+    let robots: Vec<(u32, String)> = exp
+        .arena
+        .robots()
+        .into_iter()
+        .map(|r| (r.index, r.id))
+        .collect();
+    assert_eq!(
+        robots,
+        [
+            (0, "first".to_string()),
+            (1, "d0".to_string()),
+            (2, "d1".to_string()),
+            (3, "last".to_string())
+        ]
+    );
 }

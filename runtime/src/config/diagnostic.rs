@@ -41,13 +41,17 @@ impl Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}: {}",
-            self.path.display(),
-            self.location,
-            self.message
-        )?;
+        if self.location.line == 0 {
+            write!(f, "{}: {}", self.path.display(), self.message)?;
+        } else {
+            write!(
+                f,
+                "{}:{}: {}",
+                self.path.display(),
+                self.location,
+                self.message
+            )?;
+        }
         if let Some(hint) = &self.hint {
             write!(f, " ({hint})")?;
         }

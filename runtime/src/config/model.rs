@@ -270,6 +270,21 @@ impl Controller {
         self.sensors.iter().find(|d| d.kind == kind)
     }
 
+    /// `<params profile>`: the agent profile (the set of operational procedures) named explicitly; when absent
+    /// the agent picks the profile registered for [`Controller::tag`].
+    pub fn profile(&self) -> Option<&str> {
+        self.params.get("profile")
+    }
+
+    /// `<params supervisors>`: the comma-separated supervisor files (ptSCT XML models or compiled supervisors) as
+    /// written, relative to the configuration file (resolve them with [`Experiment::resolve`]); empty when absent.
+    pub fn supervisors(&self) -> Vec<&str> {
+        self.params
+            .get("supervisors")
+            .map(|list| list.split(',').map(str::trim).collect())
+            .unwrap_or_default()
+    }
+
     /// The first actuator of the given kind.
     pub fn actuator(&self, kind: DeviceKind) -> Option<&Device> {
         self.actuators.iter().find(|d| d.kind == kind)
@@ -391,6 +406,46 @@ impl Arena {
             .collect();
         items.sort_by_key(|(loc, _)| *loc);
         items.into_iter().map(|(_, item)| item).collect()
+    }
+}
+
+/// One robot of the experiment, as [`Arena::robots`] lists them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Robot<'a> {
+    /// Position in the canonical order, from 0: the robot's slot for every process of a run.
+    pub index: u32,
+    /// The robot's id (a distribution's robots are `base id` + index, e.g. `fb0`).
+    pub id: String,
+    /// The `<e-puck>` element (for distributed robots: the template).
+    pub epuck: &'a EPuckEntity,
+}
+
+impl Arena {
+    /// Every robot in the canonical order that the launcher, the world and the agents share: arena items in file
+    /// order, each distribution expanded in index order. Robot `index` values are 0, 1, 2, ...
+    pub fn robots(&self) -> Vec<Robot<'_>> {
+        let mut robots = Vec::new();
+        for item in self.items() {
+            match item {
+                ArenaItem::Placed(PlacedEntity {
+                    entity: Entity::EPuck(epuck),
+                    ..
+                }) => {
+                    robots.push((epuck.id.clone(), epuck));
+                }
+                ArenaItem::Distribute(d) => {
+                    if let Entity::EPuck(epuck) = &d.template {
+                        robots.extend((0..d.quantity).map(|i| (d.entity_id(i), epuck)));
+                    }
+                }
+                ArenaItem::Placed(_) => {}
+            }
+        }
+        robots
+            .into_iter()
+            .zip(0u32..)
+            .map(|((id, epuck), index)| Robot { index, id, epuck })
+            .collect()
     }
 }
 

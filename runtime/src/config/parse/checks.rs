@@ -1,11 +1,11 @@
-//! Checks across sections, run once everything is read: media references, controller references and entity ids
-//! (including the ids `<distribute>` generates: base id + index, no separator).
+//! Checks across sections, run once everything is read: media references, controller references, entity ids
+//! (including the ids `<distribute>` generates: base id + index, no separator) and positions inside the arena.
 
 use std::collections::HashMap;
 
 use super::Ctx;
 use super::arena::describe;
-use crate::config::model::{Distribute, Entity, Experiment, Location};
+use crate::config::model::{Arena, Distribute, Entity, Experiment, Location, PositionMethod, Vec3};
 use crate::config::registry::MediumKind;
 use crate::config::suggest::did_you_mean;
 
@@ -14,6 +14,66 @@ pub(super) fn run(ctx: &mut Ctx, experiment: &Experiment) {
     media_references(ctx, experiment);
     controller_references(ctx, experiment);
     unique_ids(ctx, experiment);
+    inside_arena(ctx, &experiment.arena);
+}
+
+/// Tolerance for positions written exactly on the arena's edge (e.g. walls centred on it).
+const EDGE_TOLERANCE: f64 = 1e-9;
+
+/// Hand-placed positions and bounded position generators lie within the arena's x-y rectangle (edges included;
+/// Gaussian generators are unbounded and left to the world).
+fn inside_arena(ctx: &mut Ctx, arena: &Arena) {
+    let (half_x, half_y) = (arena.size.x / 2.0, arena.size.y / 2.0);
+    let (lo_x, hi_x) = (arena.center.x - half_x, arena.center.x + half_x);
+    let (lo_y, hi_y) = (arena.center.y - half_y, arena.center.y + half_y);
+    let inside = |p: Vec3| {
+        p.x >= lo_x - EDGE_TOLERANCE
+            && p.x <= hi_x + EDGE_TOLERANCE
+            && p.y >= lo_y - EDGE_TOLERANCE
+            && p.y <= hi_y + EDGE_TOLERANCE
+    };
+    let bounds = format!("the arena spans x {lo_x}..{hi_x}, y {lo_y}..{hi_y}");
+    for p in &arena.entities {
+        if !inside(p.pose.position) {
+            ctx.error(
+                p.entity.location(),
+                format!(
+                    "{} at {} is outside the arena",
+                    describe(&p.entity),
+                    p.pose.position
+                ),
+                Some(bounds.clone()),
+            );
+        }
+    }
+    for d in &arena.distributions {
+        let corners = match &d.position {
+            PositionMethod::Uniform { min, max } => Some((*min, *max)),
+            PositionMethod::Constant { values } => Some((*values, *values)),
+            PositionMethod::Grid {
+                center,
+                distances,
+                layout,
+            } => {
+                let reach = |n: u32, step: f64| f64::from(n.saturating_sub(1)) * step.abs() / 2.0;
+                let (rx, ry) = (reach(layout[0], distances.x), reach(layout[1], distances.y));
+                Some((
+                    Vec3::new(center.x - rx, center.y - ry, center.z),
+                    Vec3::new(center.x + rx, center.y + ry, center.z),
+                ))
+            }
+            PositionMethod::Gaussian { .. } => None,
+        };
+        if let Some((low, high)) = corners
+            && !(inside(low) && inside(high))
+        {
+            ctx.error(
+                d.position_location,
+                format!("<distribute> positions from {low} to {high} reach outside the arena"),
+                Some(bounds.clone()),
+            );
+        }
+    }
 }
 
 fn media_references(ctx: &mut Ctx, experiment: &Experiment) {

@@ -70,6 +70,9 @@ fn controller(ctx: &mut Ctx, el: &Element) -> Option<Controller> {
             _ => ctx.unknown_element(child, &el.name, CONTROLLER_CHILDREN),
         }
     }
+    if let Some(params) = params {
+        runtime_params(ctx, params);
+    }
     let params = params.cloned().unwrap_or_else(|| Element {
         name: "params".to_string(),
         location: el.location,
@@ -84,6 +87,37 @@ fn controller(ctx: &mut Ctx, el: &Element) -> Option<Controller> {
         params,
         location: el.location,
     })
+}
+
+/// Checks the params the runtime itself reads (`profile`, `supervisors`, `velocity`); the rest belongs to the
+/// profile and is passed on unchecked.
+fn runtime_params(ctx: &mut Ctx, params: &Element) {
+    if let Some(profile) = params.attributes.get("profile")
+        && profile.value.trim().is_empty()
+    {
+        ctx.error(
+            profile.location,
+            "'profile' in <params> is empty",
+            Some("name an agent profile, e.g. obstacle_avoidance".to_string()),
+        );
+    }
+    if let Some(list) = params.attributes.get("supervisors")
+        && list.value.split(',').any(|p| p.trim().is_empty())
+    {
+        ctx.error(
+            list.location,
+            format!(
+                "'supervisors' in <params> has an empty entry: '{}'",
+                list.value
+            ),
+            Some("separate supervisor files with single commas".to_string()),
+        );
+    }
+    if params.attributes.contains_key("velocity")
+        && let Some(velocity) = ctx.attr::<f64>(params, "velocity")
+    {
+        ctx.in_range(params, "velocity", velocity, 0.0, None);
+    }
 }
 
 /// The children of `<sensors>` or `<actuators>`.
