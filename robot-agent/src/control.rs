@@ -85,7 +85,7 @@ pub fn build(
             let where_ = supervisors.to_string();
             let loaded = match supervisors {
                 Supervisors::Builtin(_, models) => supervisors::synthesise(models),
-                Supervisors::Path(path) => supervisors::load(path),
+                Supervisors::Files(files) => supervisors::load(files),
             };
             let set = loaded.map_err(|problem| BuildError::Supervisors {
                 where_: where_.clone(),
@@ -148,7 +148,7 @@ mod tests {
     fn missing_supervisor_file_names_the_path() {
         let plan = Plan::Supervised {
             profile: "obstacle_avoidance".to_owned(),
-            supervisors: Supervisors::Path("/nonexistent/oa.sup".into()),
+            supervisors: Supervisors::Files(vec!["/nonexistent/oa.sup".into()]),
         };
         let err = build(&plan, &Params::default(), 1, 0)
             .err()

@@ -3,10 +3,11 @@
 //!
 //! A controller is either a supervisor set plus an operational-procedure profile, or a native controller. Configs
 //! written for this project name both parts in `<params>`: `profile="obstacle_avoidance"` and
-//! `supervisors="models/ptsct"` (a folder of XML models, synthesised local-modular at startup, or a compiled
-//! supervisor file; relative to the config file). Controllers without these params are looked up by element name
-//! (ARGoS style): the thesis' and ARGoS' controller names map to built-ins, and a native controller's own name
-//! selects it.
+//! `supervisors="models/ptsct"` (comma-separated XML model files or one folder of them, synthesised local-modular
+//! at startup, or one compiled supervisor file; relative to the config file). Either param alone completes the
+//! built-in of the element name (its profile, or its supervisors). Controllers without these params are looked
+//! up by element name (ARGoS style): the thesis' and ARGoS' controller names map to built-ins, and a native
+//! controller's own name selects it.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -42,15 +43,22 @@ pub enum Plan {
 pub enum Supervisors {
     /// Models built into this binary.
     Builtin(&'static str, &'static [ModelText<'static>]),
-    /// A folder of XML models or a compiled supervisor file, already resolved against the config's folder.
-    Path(PathBuf),
+    /// XML model files, one folder of XML models, or one compiled supervisor file; resolved against the
+    /// configuration's folder.
+    Files(Vec<PathBuf>),
 }
 
 impl fmt::Display for Supervisors {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Supervisors::Builtin(name, _) => write!(f, "built-in {name}"),
-            Supervisors::Path(path) => write!(f, "{}", path.display()),
+            Supervisors::Files(files) => {
+                for (i, file) in files.iter().enumerate() {
+                    let sep = if i == 0 { "" } else { ", " };
+                    write!(f, "{sep}{}", file.display())?;
+                }
+                Ok(())
+            }
         }
     }
 }
@@ -131,48 +139,69 @@ pub fn known_elements() -> impl Iterator<Item = &'static str> {
 
 /// Decides what controller element `element` with `params` runs; relative paths resolve against `base_dir`.
 pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, PlanError> {
-    let plan = match (params.get("profile"), params.get("supervisors")) {
-        (Some(profile), Some(supervisors)) => {
-            if !profiles::is_profile(profile) {
-                return Err(PlanError::UnknownProfile {
-                    name: profile.to_owned(),
-                    known: profiles::profile_names().collect::<Vec<_>>().join(", "),
+    let builtin = BUILTINS
+        .iter()
+        .find(|b| b.element == element)
+        .map(|b| (b.plan)());
+    let files: Vec<PathBuf> = params
+        .get("supervisors")
+        .into_iter()
+        .flat_map(|list| list.split(','))
+        .map(str::trim)
+        .filter(|f| !f.is_empty())
+        .map(|f| base_dir.join(f))
+        .collect();
+    let plan = match (params.get("profile"), files.is_empty()) {
+        (Some(profile), _) if !profiles::is_profile(profile) => {
+            return Err(PlanError::UnknownProfile {
+                name: profile.to_owned(),
+                known: profiles::profile_names().collect::<Vec<_>>().join(", "),
+            });
+        }
+        (Some(profile), false) => Plan::Supervised {
+            profile: profile.to_owned(),
+            supervisors: Supervisors::Files(files),
+        },
+        (Some(profile), true) => match builtin {
+            Some(Plan::Supervised { supervisors, .. }) => Plan::Supervised {
+                profile: profile.to_owned(),
+                supervisors,
+            },
+            _ => {
+                return Err(PlanError::Incomplete {
+                    given: "profile",
+                    missing: "supervisors",
                 });
             }
-            Plan::Supervised {
-                profile: profile.to_owned(),
-                supervisors: Supervisors::Path(base_dir.join(supervisors)),
+        },
+        (None, false) => match builtin {
+            Some(Plan::Supervised { profile, .. }) => Plan::Supervised {
+                profile,
+                supervisors: Supervisors::Files(files),
+            },
+            _ => {
+                return Err(PlanError::Incomplete {
+                    given: "supervisors",
+                    missing: "profile",
+                });
             }
-        }
-        (Some(_), None) => {
-            return Err(PlanError::Incomplete {
-                given: "profile",
-                missing: "supervisors",
-            });
-        }
-        (None, Some(_)) => {
-            return Err(PlanError::Incomplete {
-                given: "supervisors",
-                missing: "profile",
-            });
-        }
-        (None, None) => {
-            if let Some(builtin) = BUILTINS.iter().find(|b| b.element == element) {
-                let plan = (builtin.plan)();
-                info!("controller element `{element}` maps to {plan}");
-                plan
-            } else if native::is_native(element) {
-                Plan::Native {
-                    name: element.to_owned(),
-                }
-            } else {
+        },
+        (None, true) => match builtin {
+            Some(plan) => plan,
+            None if native::is_native(element) => Plan::Native {
+                name: element.to_owned(),
+            },
+            None => {
                 return Err(PlanError::UnknownController {
                     element: element.to_owned(),
                     known: known_elements().collect::<Vec<_>>().join(", "),
                 });
             }
-        }
+        },
     };
+    if BUILTINS.iter().any(|b| b.element == element) {
+        info!("controller element `{element}` maps to {plan}");
+    }
     Ok(plan)
 }
 
@@ -238,7 +267,7 @@ mod tests {
             p,
             Plan::Supervised {
                 profile: "obstacle_avoidance".to_owned(),
-                supervisors: Supervisors::Path(PathBuf::from("/cfg/oa/models/ptsct")),
+                supervisors: Supervisors::Files(vec![PathBuf::from("/cfg/oa/models/ptsct")]),
             }
         );
     }
@@ -257,6 +286,36 @@ mod tests {
         .unwrap();
         assert!(
             matches!(p, Plan::Supervised { profile, .. } if profile == "obstacle_avoidance_sct")
+        );
+    }
+
+    #[test]
+    fn profile_alone_keeps_the_builtin_supervisors_of_the_element() {
+        let params = Params::new([("profile", "obstacle_avoidance")]);
+        let p = plan(
+            "epuck_obstacle_avoidance_sct_prob_controller",
+            &params,
+            Path::new("/c"),
+        )
+        .unwrap();
+        assert_eq!(
+            p.to_string(),
+            "profile `obstacle_avoidance` with supervisors built-in obstacle_avoidance/ptsct"
+        );
+    }
+
+    #[test]
+    fn supervisors_alone_take_the_profile_of_the_element() {
+        let params = Params::new([("supervisors", "m/G.xml, m/E.xml")]);
+        let p = plan(
+            "epuck_obstacle_avoidance_sct_prob_controller",
+            &params,
+            Path::new("/c"),
+        )
+        .unwrap();
+        assert_eq!(
+            p.to_string(),
+            "profile `obstacle_avoidance` with supervisors /c/m/G.xml, /c/m/E.xml"
         );
     }
 

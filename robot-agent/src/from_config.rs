@@ -1,48 +1,39 @@
 //! Choosing a robot's controller from a parsed experiment, with errors located in the `.argos` file.
 //!
-//! The launcher passes the controller id of the robot (`--controller`); a configuration that declares only one
-//! controller needs no id. The controller's `<params>` attributes become the [`Params`] of its profile or native
+//! A robot's controller is the one its `<e-puck>` names, found by the robot's index in the canonical order
+//! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes become the [`Params`] of its profile or native
 //! controller, and relative paths in them resolve against the configuration's folder.
 
-use swarm_runtime::config::{Controller, Diagnostic, Experiment};
+use swarm_runtime::config::{Controller, Diagnostic, Experiment, Location};
 
 use crate::control::{self, Control};
 use crate::controller::{self, Plan};
 use crate::params::Params;
 
-/// The controller element of `experiment` with id `id`, or its only controller when `id` is `None`.
-pub fn choose<'a>(
-    experiment: &'a Experiment,
-    id: Option<&str>,
-) -> Result<&'a Controller, Diagnostic> {
-    let ids = || {
-        experiment
-            .controllers
-            .iter()
-            .map(|c| format!("`{}`", c.id))
-            .collect::<Vec<_>>()
-            .join(", ")
+/// The controller of robot `robot` (its index in the canonical robot order, `Arena::robots`).
+pub fn controller_of(experiment: &Experiment, robot: u32) -> Result<&Controller, Diagnostic> {
+    let file_level = Location { line: 0, column: 0 };
+    let robots = experiment.arena.robots();
+    let Some(entry) = robots.iter().find(|r| r.index == robot) else {
+        return Err(experiment.diagnostic(
+            file_level,
+            format!(
+                "there is no robot {robot}: the configuration has {} robots",
+                robots.len()
+            ),
+        ));
     };
-    let file_level = swarm_runtime::config::Location { line: 0, column: 0 };
-    match id {
-        Some(id) => experiment.controller(id).ok_or_else(|| {
+    experiment
+        .controller(&entry.epuck.controller)
+        .ok_or_else(|| {
             experiment.diagnostic(
-                file_level,
-                format!("no controller with id `{id}` (declared: {})", ids()),
-            )
-        }),
-        None => match experiment.controllers.as_slice() {
-            [only] => Ok(only),
-            _ => Err(experiment.diagnostic(
-                file_level,
+                entry.epuck.location,
                 format!(
-                    "{} controllers are declared ({}); say which one this robot runs with --controller",
-                    experiment.controllers.len(),
-                    ids()
+                    "robot {robot} (`{}`) names controller `{}`, which is not declared",
+                    entry.id, entry.epuck.controller
                 ),
-            )),
-        },
-    }
+            )
+        })
 }
 
 /// The `<params>` attributes of `controller`.
@@ -96,15 +87,15 @@ mod tests {
       <sensors><epuck_proximity implementation="default" /></sensors>
       <params velocity="12.8" />
     </epuck_obstacle_avoidance_sct_prob_controller>
-    <epuck_obstacleavoidance_controller id="argos" library="robot-agent">
+    <epuck_obstacle_avoidance_sct_prob_controller id="bad" library="robot-agent">
       <actuators><epuck_wheels implementation="default" /></actuators>
       <sensors><epuck_proximity implementation="default" /></sensors>
-      <params velocity="fast" />
-    </epuck_obstacleavoidance_controller>
+      <params theta_obs="2" />
+    </epuck_obstacle_avoidance_sct_prob_controller>
   </controllers>
   <arena size="1,1,1" center="0,0,0.5">
     <e-puck id="r0"><body position="0,0,0" orientation="0,0,0" /><controller config="fdc" /></e-puck>
-    <e-puck id="r1"><body position="0.2,0,0" orientation="0,0,0" /><controller config="argos" /></e-puck>
+    <e-puck id="r1"><body position="0.2,0,0" orientation="0,0,0" /><controller config="bad" /></e-puck>
   </arena>
   <physics_engines><dynamics2d id="dyn2d" /></physics_engines>
   <media />
@@ -119,37 +110,25 @@ mod tests {
     }
 
     #[test]
-    fn controller_is_chosen_by_id() {
+    fn robot_index_selects_its_controller() {
         let e = experiment();
-        assert_eq!(
-            choose(&e, Some("argos")).unwrap().tag,
-            "epuck_obstacleavoidance_controller"
-        );
+        assert_eq!(controller_of(&e, 0).unwrap().id, "fdc");
+        assert_eq!(controller_of(&e, 1).unwrap().id, "bad");
     }
 
     #[test]
-    fn several_controllers_need_an_id() {
+    fn robot_beyond_the_configuration_is_rejected() {
         let e = experiment();
         assert_eq!(
-            choose(&e, None).unwrap_err().to_string(),
-            "/cfg/two.argos:0:0: 2 controllers are declared (`fdc`, `argos`); say which one this robot runs with \
-             --controller"
-        );
-    }
-
-    #[test]
-    fn unknown_id_lists_the_declared_ones() {
-        let e = experiment();
-        assert_eq!(
-            choose(&e, Some("x")).unwrap_err().to_string(),
-            "/cfg/two.argos:0:0: no controller with id `x` (declared: `fdc`, `argos`)"
+            controller_of(&e, 2).unwrap_err().to_string(),
+            "/cfg/two.argos: there is no robot 2: the configuration has 2 robots"
         );
     }
 
     #[test]
     fn thesis_controller_builds_from_the_config() {
         let e = experiment();
-        let (plan, _) = build(&e, choose(&e, Some("fdc")).unwrap(), 1, 0).unwrap();
+        let (plan, _) = build(&e, controller_of(&e, 0).unwrap(), 1, 0).unwrap();
         assert_eq!(
             plan.to_string(),
             "profile `obstacle_avoidance` with supervisors built-in obstacle_avoidance/ptsct"
@@ -159,14 +138,14 @@ mod tests {
     #[test]
     fn bad_param_is_located_at_the_params_element() {
         let e = experiment();
-        let err = build(&e, choose(&e, Some("argos")).unwrap(), 1, 0)
+        let err = build(&e, controller_of(&e, 1).unwrap(), 1, 0)
             .err()
             .unwrap()
             .to_string();
         assert_eq!(
             err,
-            "/cfg/two.argos:15:7: controller `argos` (<epuck_obstacleavoidance_controller>): native controller \
-             `epuck_obstacleavoidance`: parameter `velocity` = \"fast\" is not a finite number"
+            "/cfg/two.argos:15:7: controller `bad` (<epuck_obstacle_avoidance_sct_prob_controller>): profile \
+             `obstacle_avoidance`: parameter `theta_obs` = 2 is out of range: must be in [0, 1]"
         );
     }
 }

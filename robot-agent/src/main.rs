@@ -34,20 +34,17 @@ struct Args {
     /// configuration's `random_seed`, or 0 without --config.
     #[arg(long)]
     seed: Option<u64>,
-    /// Experiment configuration (.argos); the robot runs the controller named by --controller.
+    /// Experiment configuration (.argos); the robot runs the controller its `<e-puck>` names.
     #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
     config: Option<PathBuf>,
-    /// Id of the robot's controller in --config (default: the configuration's only controller).
-    #[arg(long, requires = "config")]
-    controller: Option<String>,
     /// Without --config: controller element name, as a `<controllers>` child would be named.
     #[arg(long, default_value = "")]
     element: String,
     /// Without --config: operational-procedure profile (with --supervisors).
     #[arg(long, requires = "supervisors")]
     profile: Option<String>,
-    /// Without --config: folder of XML models or compiled supervisor-set file (with --profile), relative to the
-    /// working directory.
+    /// Without --config: comma-separated XML model files, one folder of them, or one compiled supervisor-set file
+    /// (with --profile), relative to the working directory.
     #[arg(long, requires = "profile")]
     supervisors: Option<String>,
     /// Without --config: controller parameter, as an attribute of <params> (repeatable), e.g. --param velocity=5.
@@ -80,7 +77,7 @@ fn build_control(args: &Args) -> Result<Control> {
                 path.display()
             ),
         };
-        let controller = from_config::choose(&experiment, args.controller.as_deref())?;
+        let controller = from_config::controller_of(&experiment, args.robot)?;
         let (plan, control) = from_config::build(&experiment, controller, seed, args.robot)?;
         info!(
             controller = controller.id.as_str(),

@@ -26,7 +26,7 @@ pub enum ParamError {
         name: String,
         /// Value as written.
         value: String,
-        /// The rule it breaks, e.g. "must be > 0".
+        /// The rule it breaks, e.g. "must be >= 0".
         rule: &'static str,
     },
 }
@@ -82,16 +82,16 @@ impl Params {
         }
     }
 
-    /// `name` as a finite `f32` strictly greater than zero, or `default` when absent.
-    pub fn positive_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+    /// `name` as a finite `f32` >= 0 (a speed), or `default` when absent.
+    pub fn non_negative_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
         let v = self.f32_or(name, default)?;
-        if v > 0.0 {
+        if v >= 0.0 {
             Ok(v)
         } else {
             Err(ParamError::OutOfRange {
                 name: name.to_owned(),
                 value: self.get(name).unwrap_or_default().to_owned(),
-                rule: "must be > 0",
+                rule: "must be >= 0",
             })
         }
     }
@@ -123,7 +123,7 @@ mod tests {
     #[test]
     fn velocity_parses_as_written_in_the_thesis_config() {
         let p = Params::new([("velocity", "12.8")]);
-        assert_eq!(p.positive_f32_or("velocity", 1.0), Ok(12.8));
+        assert_eq!(p.non_negative_f32_or("velocity", 1.0), Ok(12.8));
     }
 
     #[test]
@@ -139,10 +139,10 @@ mod tests {
     #[test]
     fn negative_velocity_is_rejected() {
         let p = Params::new([("velocity", "-3")]);
-        let err = p.positive_f32_or("velocity", 12.8).unwrap_err();
+        let err = p.non_negative_f32_or("velocity", 12.8).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "parameter `velocity` = -3 is out of range: must be > 0"
+            "parameter `velocity` = -3 is out of range: must be >= 0"
         );
     }
 

@@ -75,6 +75,14 @@ pub enum SupervisorError {
         /// The OS error.
         problem: std::io::Error,
     },
+    /// No supervisor file was named.
+    #[error("no supervisor files given")]
+    NoFiles,
+    /// XML models and compiled files were mixed.
+    #[error(
+        "give either XML model files (or one folder of them) or one compiled supervisor file, not a mix"
+    )]
+    Mixed,
     /// A folder of models holds no `.xml` file.
     #[error("{}: no .xml model files in this folder", path.display())]
     NoModels {
@@ -98,29 +106,19 @@ pub enum SupervisorError {
     Compiled(#[from] CompiledFormatError),
 }
 
-/// Loads a supervisor set from `path`: a folder of XML models (synthesised local-modular) or a compiled file.
-pub fn load(path: &Path) -> Result<SupervisorSet, SupervisorError> {
-    if !path.is_dir() {
-        return Ok(SupervisorSet::read(path)?);
-    }
-    let io = |problem| SupervisorError::Io {
-        path: path.to_owned(),
-        problem,
+/// Loads a supervisor set from `files`: XML model files, or one folder of them (synthesised local-modular), or
+/// one compiled supervisor-set file.
+pub fn load(files: &[PathBuf]) -> Result<SupervisorSet, SupervisorError> {
+    let is_xml = |p: &Path| p.extension().is_some_and(|x| x == "xml");
+    let models: Vec<PathBuf> = match files {
+        [] => return Err(SupervisorError::NoFiles),
+        [one] if one.is_dir() => models_in(one)?,
+        [one] if !is_xml(one) => return Ok(SupervisorSet::read(one)?),
+        many if many.iter().all(|p| is_xml(p)) => many.to_vec(),
+        _ => return Err(SupervisorError::Mixed),
     };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(path)
-        .map_err(io)?
-        .map(|entry| entry.map(|e| e.path()))
-        .collect::<Result<_, _>>()
-        .map_err(io)?;
-    files.retain(|p| p.extension().is_some_and(|x| x == "xml"));
-    files.sort();
-    if files.is_empty() {
-        return Err(SupervisorError::NoModels {
-            path: path.to_owned(),
-        });
-    }
-    let mut texts = Vec::with_capacity(files.len());
-    for file in &files {
+    let mut texts = Vec::with_capacity(models.len());
+    for file in &models {
         let text = std::fs::read_to_string(file).map_err(|problem| SupervisorError::Io {
             path: file.clone(),
             problem,
@@ -132,6 +130,27 @@ pub fn load(path: &Path) -> Result<SupervisorSet, SupervisorError> {
         .map(|(file, text)| ModelText { file, text })
         .collect();
     synthesise(&models)
+}
+
+/// The `.xml` files of folder `dir`, sorted by name.
+fn models_in(dir: &Path) -> Result<Vec<PathBuf>, SupervisorError> {
+    let io = |problem| SupervisorError::Io {
+        path: dir.to_owned(),
+        problem,
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .map(|entry| entry.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .map_err(io)?;
+    files.retain(|p| p.extension().is_some_and(|x| x == "xml"));
+    files.sort();
+    if files.is_empty() {
+        return Err(SupervisorError::NoModels {
+            path: dir.to_owned(),
+        });
+    }
+    Ok(files)
 }
 
 /// Validates `models` and synthesises their local-modular supervisor set.
@@ -208,15 +227,21 @@ mod tests {
     }
 
     #[test]
+    fn xml_models_and_a_compiled_file_cannot_be_mixed() {
+        let files = [PathBuf::from("G.xml"), PathBuf::from("set.sup")];
+        assert!(matches!(load(&files), Err(SupervisorError::Mixed)));
+    }
+
+    #[test]
     fn folder_without_models_is_rejected() {
         let dir = tempfile::tempdir().unwrap();
-        let err = load(dir.path()).unwrap_err();
+        let err = load(&[dir.path().to_owned()]).unwrap_err();
         assert!(matches!(err, SupervisorError::NoModels { .. }));
     }
 
     #[test]
     fn missing_compiled_file_names_the_path() {
-        let err = load(Path::new("/nonexistent/oa.sup"))
+        let err = load(&[PathBuf::from("/nonexistent/oa.sup")])
             .unwrap_err()
             .to_string();
         assert!(err.contains("/nonexistent/oa.sup"), "{err}");

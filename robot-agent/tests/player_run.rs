@@ -40,7 +40,7 @@ impl Robot {
         let dir =
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/obstacle_avoidance/models/sct");
         Robot::new(
-            supervisors::load(&dir).unwrap(),
+            supervisors::load(&[dir]).unwrap(),
             "obstacle_avoidance_sct",
             seed,
         )

@@ -26,10 +26,10 @@ impl EpuckObstacleAvoidance {
     /// Registry name.
     pub const NAME: &'static str = "epuck_obstacleavoidance";
 
-    /// Reads `velocity` (cm/s, > 0).
+    /// Reads `velocity` (cm/s, >= 0).
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
         Ok(Self {
-            velocity: params.positive_f32_or("velocity", DEFAULT_VELOCITY)?,
+            velocity: params.non_negative_f32_or("velocity", DEFAULT_VELOCITY)?,
         })
     }
 }

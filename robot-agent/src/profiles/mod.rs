@@ -159,12 +159,16 @@ mod tests {
 
     #[test]
     fn bad_velocity_is_reported_with_the_profile_name() {
-        let err = bind_profile("obstacle_avoidance", &Params::new([("velocity", "0")]), &[])
-            .err()
-            .unwrap();
+        let err = bind_profile(
+            "obstacle_avoidance",
+            &Params::new([("velocity", "-1")]),
+            &[],
+        )
+        .err()
+        .unwrap();
         assert_eq!(
             err.to_string(),
-            "profile `obstacle_avoidance`: parameter `velocity` = 0 is out of range: must be > 0"
+            "profile `obstacle_avoidance`: parameter `velocity` = -1 is out of range: must be >= 0"
         );
     }
 }

@@ -43,10 +43,10 @@ pub struct Walker {
 }
 
 impl Walker {
-    /// Reads `velocity` (cm/s, > 0) and `theta_obs` (in [0, 1]).
+    /// Reads `velocity` (cm/s, >= 0) and `theta_obs` (in [0, 1]).
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
         Ok(Self {
-            velocity: params.positive_f32_or("velocity", DEFAULT_VELOCITY)?,
+            velocity: params.non_negative_f32_or("velocity", DEFAULT_VELOCITY)?,
             theta_obs: params.unit_f32_or("theta_obs", DEFAULT_THETA_OBS)?,
         })
     }
