@@ -20,6 +20,7 @@ mod nadzoru;
 pub mod normalise;
 pub mod pipeline;
 pub mod product;
+pub mod report;
 pub mod source;
 pub mod supc;
 pub mod trim;

@@ -130,18 +130,18 @@ fn element(file: &str, index: &LineIndex<'_>, start: &BytesStart<'_>) -> Result<
     let mut attrs = Vec::new();
     for attr in start.attributes() {
         let attr = attr.map_err(|e| {
-            let rel = match e {
-                AttrError::ExpectedEq(p)
-                | AttrError::ExpectedValue(p)
-                | AttrError::UnquotedValue(p)
-                | AttrError::ExpectedQuote(p, _)
-                | AttrError::Duplicated(p, _) => p,
+            let (rel, what) = match e {
+                AttrError::ExpectedEq(p) => (p, "attribute name is not followed by `=`"),
+                AttrError::ExpectedValue(p) => (p, "attribute has no value after `=`"),
+                AttrError::UnquotedValue(p) => (p, "attribute value is not enclosed in quotes"),
+                AttrError::ExpectedQuote(p, _) => (p, "attribute value has no closing quote"),
+                AttrError::Duplicated(p, _) => (p, "attribute appears twice"),
             };
             Diagnostic::new(
                 Code::X1,
                 file,
                 index.position(base + rel),
-                format!("malformed attribute in `<{name}>`: {e}"),
+                format!("malformed attribute in `<{name}>`: {what}"),
             )
         })?;
         let key_at = index.position_of(attr.key.as_ref());
