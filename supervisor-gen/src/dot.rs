@@ -60,9 +60,9 @@ pub fn to_dot(
             attrs.push("shape=doublecircle".into());
         }
         match marks.get(&state) {
-            Some(StateMark::Bad) => {
-                attrs.push("style=filled, fillcolor=\"#ff9999\", color=red, fontcolor=\"#990000\"".into())
-            }
+            Some(StateMark::Bad) => attrs.push(
+                "style=filled, fillcolor=\"#ff9999\", color=red, fontcolor=\"#990000\"".into(),
+            ),
             Some(StateMark::Removed) => attrs.push("style=dashed, color=red, fontcolor=red".into()),
             None => {}
         }
@@ -131,7 +131,13 @@ fn quote(s: &str) -> String {
 pub fn file_stem(name: &str) -> String {
     let stem: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     if stem.is_empty() { "_".into() } else { stem }
 }

@@ -31,7 +31,7 @@ impl Input {
 
 /// A model file could not be read.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot read {path}: {source}")]
+#[error("cannot read {path}")]
 pub struct LoadError {
     /// The file.
     pub path: String,

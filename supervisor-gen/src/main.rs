@@ -1,5 +1,504 @@
-//! `supervisor-gen` command line.
+//! `supervisor-gen` command line: validate, synthesise, draw and compile ptSCT supervisors.
+//!
+//! Exit codes: 0 success; 1 invalid input (any validation error) or an impossible specification; 2 usage or I/O
+//! problems. Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
 
-fn main() {
-    println!("supervisor-gen: not yet implemented");
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use supervisor_gen::architecture::Architecture;
+use supervisor_gen::automaton::{Automaton, EventTable, ModelKind};
+use supervisor_gen::codegen::generate_rust;
+use supervisor_gen::convert::{to_automata, to_project};
+use supervisor_gen::diagnostics::{Diagnostic, Severity};
+use supervisor_gen::dot::{self, ProbLabels, StateMark};
+use supervisor_gen::load::{Input, load};
+use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis, SynthesisOptions, synthesize};
+use supervisor_gen::report::Report;
+use supervisor_gen::supc::RemovalReason;
+use supervisor_gen::validate::{CheckedModel, ValidateOptions};
+use supervisor_gen::xml_write::to_xml;
+
+/// ptSCT toolchain: validate plant and specification automata, synthesise, minimise, draw and compile supervisors.
+///
+/// Model files are plain paths (no globs): the thesis XML format (`<automata>`) or Nadzoru2 FSA files
+/// (`<model type="FSA">`), told apart by their root element.
+/// Exit codes: 0 success, 1 invalid input or impossible specification, 2 usage or I/O error.
+#[derive(Debug, Parser)]
+#[command(name = "supervisor-gen", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Validate, synthesise and write supervisors XML, supervisors.ptsct, supervisors.rs, report.json (and drawings).
+    Synth(SynthArgs),
+    /// Validate model files only and print every diagnostic.
+    Check(CheckArgs),
+    /// Draw model files as DOT (and SVG/PNG when Graphviz `dot` is on PATH).
+    Draw(DrawArgs),
+    /// Synthesise and write only the generated Rust module.
+    Codegen(CodegenArgs),
+}
+
+/// The models of a project.
+#[derive(Debug, Args)]
+struct ProjectArgs {
+    /// Plant (free-behaviour) model files; repeat the flag or list several paths.
+    #[arg(long = "plant", value_name = "FILE", num_args = 1.., required = true)]
+    plants: Vec<PathBuf>,
+    /// Specification model files; repeat the flag or list several paths.
+    #[arg(long = "spec", value_name = "FILE", num_args = 1.., required = true)]
+    specs: Vec<PathBuf>,
+    /// Supervisor architecture (section 6.6).
+    #[arg(long, value_enum, default_value_t = Mode::LocalModular)]
+    mode: Mode,
+    /// Keep specification weights as written (no input normalisation, no monolithic renormalisation).
+    #[arg(long)]
+    raw_weights: bool,
+    /// Keep plant probabilities as factors (compatibility with the thesis' literal composition rule, A5).
+    #[arg(long)]
+    thesis_literal_probabilities: bool,
+}
+
+#[derive(Debug, Args)]
+struct SynthArgs {
+    #[command(flatten)]
+    project: ProjectArgs,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Also draw every input, intermediate (G, E, K, SupC) and final supervisor into DIR/drawings.
+    #[arg(long)]
+    draw: bool,
+}
+
+#[derive(Debug, Args)]
+struct CheckArgs {
+    /// Model files whose own `type` attribute says what they are.
+    #[arg(value_name = "FILE")]
+    files: Vec<PathBuf>,
+    /// Files to check as plants (needed for Nadzoru2 files, which have no type).
+    #[arg(long = "plant", value_name = "FILE", num_args = 1..)]
+    plants: Vec<PathBuf>,
+    /// Files to check as specifications.
+    #[arg(long = "spec", value_name = "FILE", num_args = 1..)]
+    specs: Vec<PathBuf>,
+    /// Keep plant probabilities (no W4; V12 applies to plants).
+    #[arg(long)]
+    thesis_literal_probabilities: bool,
+}
+
+#[derive(Debug, Args)]
+struct DrawArgs {
+    #[command(flatten)]
+    files: CheckArgs,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+#[derive(Debug, Args)]
+struct CodegenArgs {
+    #[command(flatten)]
+    project: ProjectArgs,
+    /// The Rust file to write.
+    #[arg(long, value_name = "FILE.rs")]
+    out: PathBuf,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Mode {
+    Monolithic,
+    Modular,
+    LocalModular,
+}
+
+impl From<Mode> for Architecture {
+    fn from(mode: Mode) -> Self {
+        match mode {
+            Mode::Monolithic => Architecture::Monolithic,
+            Mode::Modular => Architecture::Modular,
+            Mode::LocalModular => Architecture::LocalModular,
+        }
+    }
+}
+
+/// How a command ended when it did not fail with an I/O or usage error.
+enum Outcome {
+    Success,
+    /// Invalid input or an impossible specification (already explained on stderr).
+    Rejected,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Synth(args) => synth(&args),
+        Command::Check(args) => check(&args),
+        Command::Draw(args) => draw(&args),
+        Command::Codegen(args) => codegen(&args),
+    };
+    match result {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::Rejected) => ExitCode::from(1),
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Inputs of the files of a `check`/`draw` command.
+fn check_inputs(args: &CheckArgs) -> Vec<Input> {
+    let typed = args.files.iter().map(|p| Input::new(p, None));
+    let plants = args
+        .plants
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Plant)));
+    let specs = args
+        .specs
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Spec)));
+    typed.chain(plants).chain(specs).collect()
+}
+
+fn project_inputs(args: &ProjectArgs) -> Vec<Input> {
+    let plants = args
+        .plants
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Plant)));
+    let specs = args
+        .specs
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Spec)));
+    plants.chain(specs).collect()
+}
+
+/// Prints every diagnostic and a count line to stderr.
+fn print_diagnostics(diagnostics: &[Diagnostic]) {
+    for d in diagnostics {
+        eprintln!("{d}");
+    }
+    let errors = diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .count();
+    let warnings = diagnostics.len() - errors;
+    if errors > 0 {
+        eprintln!("{errors} error(s), {warnings} warning(s)");
+    } else if warnings > 0 {
+        eprintln!("{warnings} warning(s)");
+    }
+}
+
+/// Loads and validates; prints diagnostics. `None` if the input is invalid.
+fn validated(
+    inputs: &[Input],
+    options: ValidateOptions,
+) -> Result<Option<(Vec<CheckedModel>, Vec<Diagnostic>)>> {
+    if inputs.is_empty() {
+        anyhow::bail!("no model files given");
+    }
+    let validation = load(inputs, options)?;
+    print_diagnostics(&validation.diagnostics);
+    Ok(validation.models.map(|m| (m, validation.diagnostics)))
+}
+
+fn check(args: &CheckArgs) -> Result<Outcome> {
+    let options = ValidateOptions {
+        thesis_literal_probabilities: args.thesis_literal_probabilities,
+    };
+    let inputs = check_inputs(args);
+    Ok(match validated(&inputs, options)? {
+        Some(_) => {
+            println!("{} model(s) valid", inputs.len());
+            Outcome::Success
+        }
+        None => Outcome::Rejected,
+    })
+}
+
+fn draw(args: &DrawArgs) -> Result<Outcome> {
+    let options = ValidateOptions {
+        thesis_literal_probabilities: args.files.thesis_literal_probabilities,
+    };
+    let Some((models, _)) = validated(&check_inputs(&args.files), options)? else {
+        return Ok(Outcome::Rejected);
+    };
+    let (events, automata) = to_automata(&models)?;
+    create_dir(&args.out)?;
+    let mut written = 0;
+    for a in &automata {
+        written += draw_one(
+            &args.out,
+            &dot::file_stem(a.name()),
+            a,
+            &events,
+            &[],
+            ProbLabels::PerState,
+        )?;
+    }
+    println!(
+        "{written} drawing file(s) written to {}",
+        args.out.display()
+    );
+    Ok(Outcome::Success)
+}
+
+/// Validates and synthesises a project; `None` (with the reason printed) if the input is invalid or impossible.
+fn synthesised(args: &ProjectArgs) -> Result<Option<(Synthesis, Vec<Diagnostic>)>> {
+    let options = ValidateOptions {
+        thesis_literal_probabilities: args.thesis_literal_probabilities,
+    };
+    let Some((models, diagnostics)) = validated(&project_inputs(args), options)? else {
+        return Ok(None);
+    };
+    let project = to_project(&models)?;
+    let options = SynthesisOptions {
+        raw_weights: args.raw_weights,
+        thesis_literal_probabilities: args.thesis_literal_probabilities,
+        ..SynthesisOptions::default()
+    };
+    match synthesize(&project, args.mode.into(), options) {
+        Ok(s) => Ok(Some((s, diagnostics))),
+        Err(err) => {
+            eprintln!("error: {err}");
+            Ok(None)
+        }
+    }
+}
+
+fn codegen(args: &CodegenArgs) -> Result<Outcome> {
+    let Some((synthesis, _)) = synthesised(&args.project)? else {
+        return Ok(Outcome::Rejected);
+    };
+    let set = match synthesis.compile() {
+        Ok(set) => set,
+        Err(err) => {
+            eprintln!("error[V15]: {err}");
+            return Ok(Outcome::Rejected);
+        }
+    };
+    let origin = origin(&args.project, synthesis.architecture);
+    write(&args.out, generate_rust(&set, &origin))?;
+    println!(
+        "{} supervisor(s), MemCons {} bytes: {}",
+        set.supervisors.len(),
+        set.mem_cons(),
+        args.out.display()
+    );
+    Ok(Outcome::Success)
+}
+
+fn synth(args: &SynthArgs) -> Result<Outcome> {
+    let Some((synthesis, diagnostics)) = synthesised(&args.project)? else {
+        return Ok(Outcome::Rejected);
+    };
+    let set = match synthesis.compile() {
+        Ok(set) => set,
+        Err(err) => {
+            eprintln!("error[V15]: {err}");
+            return Ok(Outcome::Rejected);
+        }
+    };
+    let out = &args.out;
+    create_dir(out)?;
+    let events = &synthesis.normalised.events;
+    let mut files = Vec::new();
+    for s in &synthesis.supervisors {
+        let file = format!("{}.xml", dot::file_stem(&s.name));
+        write(&out.join(&file), to_xml(&s.supervisor, events))?;
+        files.push(file);
+    }
+    let bytes = set.to_bytes();
+    write(&out.join("supervisors.ptsct"), &bytes)?;
+    write(
+        &out.join("supervisors.rs"),
+        generate_rust(&set, &origin(&args.project, synthesis.architecture)),
+    )?;
+    let report = Report::new(&synthesis, &files, bytes.len(), &diagnostics);
+    write(&out.join("report.json"), report.to_json())?;
+    if args.draw {
+        draw_synthesis(&out.join("drawings"), &synthesis)?;
+    }
+    print_summary(&synthesis, set.mem_cons(), out);
+    Ok(Outcome::Success)
+}
+
+/// A one-line description of the inputs for the generated module's header.
+fn origin(args: &ProjectArgs, architecture: Architecture) -> String {
+    let names = |paths: &[PathBuf]| {
+        paths
+            .iter()
+            .map(|p| {
+                p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned(),
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    format!(
+        "supervisor-gen synth --mode {architecture} --plant {} --spec {}",
+        names(&args.plants),
+        names(&args.specs)
+    )
+}
+
+fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
+    for s in &synthesis.supervisors {
+        println!(
+            "{}: {} states, {} transitions ({} controllable), {} events; {} state(s) of K removed",
+            s.name,
+            s.stats.states,
+            s.stats.transitions,
+            s.stats.controllable_transitions,
+            s.stats.events,
+            s.removed.len()
+        );
+    }
+    if let Some(nc) = &synthesis.non_conflict {
+        if nc.nonblocking {
+            println!("non-conflict: the supervisors are nonblocking together");
+        } else {
+            println!(
+                "warning: the supervisors conflict: {} blocking product state(s), e.g. {}",
+                nc.blocking_count,
+                nc.blocking_states.join(", ")
+            );
+        }
+    }
+    if let Some(v) = &synthesis.local_modular_validation {
+        if v.passed() {
+            println!(
+                "local-modular validation: the local supervisors equal the monolithic supervisor"
+            );
+        } else {
+            println!(
+                "warning: local-modular validation failed: see report.json (architecture_checks)"
+            );
+        }
+    }
+    println!("MemCons {mem_cons} bytes; outputs in {}", out.display());
+}
+
+/// Draws the project's inputs (once) and every stage of every supervisor.
+fn draw_synthesis(dir: &Path, synthesis: &Synthesis) -> Result<()> {
+    create_dir(dir)?;
+    let events = &synthesis.normalised.events;
+    let project = &synthesis.normalised;
+    for a in project.plants.iter().chain(&project.specs) {
+        draw_one(
+            dir,
+            &format!("input_{}", dot::file_stem(a.name())),
+            a,
+            events,
+            &[],
+            ProbLabels::Stored,
+        )?;
+    }
+    let all = synthesis
+        .supervisors
+        .iter()
+        .chain(&synthesis.monolithic_reference);
+    for s in all {
+        draw_stages(dir, s, events)?;
+    }
+    Ok(())
+}
+
+fn draw_stages(dir: &Path, s: &SupervisorSynthesis, events: &EventTable) -> Result<()> {
+    let stem = dot::file_stem(&s.name);
+    let marks: Vec<_> = s
+        .removed
+        .iter()
+        .map(|r| {
+            let mark = match r.reason {
+                RemovalReason::Bad { .. } => StateMark::Bad,
+                _ => StateMark::Removed,
+            };
+            (r.state, mark)
+        })
+        .collect();
+    draw_one(
+        dir,
+        &format!("{stem}_1_G"),
+        &s.plant,
+        events,
+        &[],
+        ProbLabels::Stored,
+    )?;
+    draw_one(
+        dir,
+        &format!("{stem}_2_E"),
+        &s.spec,
+        events,
+        &[],
+        ProbLabels::Stored,
+    )?;
+    draw_one(
+        dir,
+        &format!("{stem}_3_K"),
+        &s.target,
+        events,
+        &marks,
+        ProbLabels::Stored,
+    )?;
+    draw_one(
+        dir,
+        &format!("{stem}_4_supc"),
+        &s.unminimised,
+        events,
+        &[],
+        ProbLabels::Stored,
+    )?;
+    draw_one(
+        dir,
+        &format!("{stem}_5_final"),
+        &s.supervisor,
+        events,
+        &[],
+        ProbLabels::Stored,
+    )?;
+    Ok(())
+}
+
+/// Writes one drawing; returns the number of files written.
+fn draw_one(
+    dir: &Path,
+    stem: &str,
+    a: &Automaton,
+    events: &EventTable,
+    marks: &[(supervisor_gen::automaton::StateId, StateMark)],
+    probs: ProbLabels,
+) -> Result<usize> {
+    let marks = marks.iter().copied().collect();
+    let text = dot::to_dot(a, events, &marks, probs);
+    let written = dot::write_drawing(dir, stem, &text)
+        .with_context(|| format!("cannot write drawing {stem} in {}", dir.display()))?;
+    Ok(written.len())
+}
+
+fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
+fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("cannot write {}", path.display()))
 }

@@ -193,7 +193,11 @@ impl Report {
             .zip(files)
             .map(|(s, file)| supervisor_report(s, file, events))
             .collect();
-        let finals: Vec<&Automaton> = synthesis.supervisors.iter().map(|s| &s.supervisor).collect();
+        let finals: Vec<&Automaton> = synthesis
+            .supervisors
+            .iter()
+            .map(|s| &s.supervisor)
+            .collect();
         let mut mem = MemConsReport {
             formula_bytes: synthesis.mem_cons,
             s: 0,
@@ -217,7 +221,10 @@ impl Report {
             mem_cons: mem,
             architecture_checks: ArchitectureChecks {
                 non_conflict: synthesis.non_conflict.as_ref().map(non_conflict),
-                local_modular_validation: synthesis.local_modular_validation.as_ref().map(validation),
+                local_modular_validation: synthesis
+                    .local_modular_validation
+                    .as_ref()
+                    .map(validation),
             },
             warnings: diagnostics
                 .iter()
@@ -300,16 +307,22 @@ fn validation(v: &LocalModularValidation) -> ValidationReport {
         non_conflict: non_conflict(&v.non_conflict),
         same_language: v.comparison.same_language,
         same_marked_language: v.comparison.same_marked_language,
-        counterexample: v.comparison.counterexample.as_ref().map(|c| CounterexampleReport {
-            string: c.string.clone(),
-            difference: match c.difference {
-                Difference::GeneratedOnlyByFirst => "generated only by the local product",
-                Difference::GeneratedOnlyBySecond => "generated only by the monolithic supervisor",
-                Difference::MarkedOnlyByFirst => "marked only by the local product",
-                Difference::MarkedOnlyBySecond => "marked only by the monolithic supervisor",
-            }
-            .to_owned(),
-        }),
+        counterexample: v
+            .comparison
+            .counterexample
+            .as_ref()
+            .map(|c| CounterexampleReport {
+                string: c.string.clone(),
+                difference: match c.difference {
+                    Difference::GeneratedOnlyByFirst => "generated only by the local product",
+                    Difference::GeneratedOnlyBySecond => {
+                        "generated only by the monolithic supervisor"
+                    }
+                    Difference::MarkedOnlyByFirst => "marked only by the local product",
+                    Difference::MarkedOnlyBySecond => "marked only by the monolithic supervisor",
+                }
+                .to_owned(),
+            }),
         label_mismatches: v
             .comparison
             .label_mismatches

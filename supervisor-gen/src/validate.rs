@@ -7,8 +7,8 @@
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
-use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
 use crate::automaton::ModelKind;
+use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
 use crate::source::{Located, SourceFormat, SourceModel, parse_kind};
 
 /// Limits of the compiled byte layout (section 9) that input models are checked against (V15).
@@ -115,10 +115,7 @@ pub fn validate(sources: &[SourceModel], options: ValidateOptions) -> Validation
 
 /// The kind a model is treated as: its declared type if valid.
 fn declared_kind(source: &SourceModel) -> Option<ModelKind> {
-    source
-        .kind
-        .as_ref()
-        .and_then(|k| parse_kind(&k.value))
+    source.kind.as_ref().and_then(|k| parse_kind(&k.value))
 }
 
 /// Per-file rules. Returns the typed model when the file could be resolved (errors may still have been reported).
@@ -128,15 +125,19 @@ fn check_file(
     out: &mut Vec<Diagnostic>,
 ) -> Option<CheckedModel> {
     let file = source.file.as_str();
-    let mut report =
-        |code: Code, at: Position, message: String| out.push(Diagnostic::new(code, file, at, message));
+    let mut report = |code: Code, at: Position, message: String| {
+        out.push(Diagnostic::new(code, file, at, message))
+    };
 
     // V13: type.
     let kind = match &source.kind {
         None => {
             let message = match source.format {
                 SourceFormat::Thesis => {
-                    format!("model `{}` has no `type` (expected plant or spec)", source.name.value)
+                    format!(
+                        "model `{}` has no `type` (expected plant or spec)",
+                        source.name.value
+                    )
                 }
                 SourceFormat::Nadzoru => format!(
                     "Nadzoru2 model `{}` carries no type: pass it with --plant or --spec",
@@ -163,7 +164,10 @@ fn check_file(
                     report(
                         Code::V13,
                         k.at,
-                        format!("model `{}` declares type `{kind}` but was passed as --{role}", source.name.value),
+                        format!(
+                            "model `{}` declares type `{kind}` but was passed as --{role}",
+                            source.name.value
+                        ),
                     );
                 }
                 Some(kind)
@@ -262,7 +266,8 @@ fn check_file(
             report(
                 Code::V14,
                 decl.name.at,
-                "event name `tick` is reserved for the global clock and must not be declared".into(),
+                "event name `tick` is reserved for the global clock and must not be declared"
+                    .into(),
             );
         }
         if decl.controllable.is_none() {
@@ -295,53 +300,75 @@ fn check_file(
             report(
                 Code::V4,
                 decl.event.at,
-                format!("transition uses event `{}`, which is not declared in `<events>`", decl.event.value),
+                format!(
+                    "transition uses event `{}`, which is not declared in `<events>`",
+                    decl.event.value
+                ),
             );
         }
-        let state = |name: &Located<String>, role: &str, report: &mut dyn FnMut(Code, Position, String)| {
-            let found = state_index.get(name.value.as_str()).copied();
-            if found.is_none() {
-                report(
-                    Code::V5,
-                    name.at,
-                    format!("transition {role} `{}` is not declared in `<states>`", name.value),
-                );
-            }
-            found
-        };
+        let state =
+            |name: &Located<String>, role: &str, report: &mut dyn FnMut(Code, Position, String)| {
+                let found = state_index.get(name.value.as_str()).copied();
+                if found.is_none() {
+                    report(
+                        Code::V5,
+                        name.at,
+                        format!(
+                            "transition {role} `{}` is not declared in `<states>`",
+                            name.value
+                        ),
+                    );
+                }
+                found
+            };
         let src = state(&decl.src, "source", &mut report);
         let dst = state(&decl.dst, "target", &mut report);
         let controllable = event.map(|e| events[e].controllable);
-        let weight = decl.prob.as_ref().and_then(|p| match p.value.parse::<f64>() {
-            Ok(w) if w.is_finite() && w >= 0.0 => Some(w),
-            _ => {
-                report(
-                    Code::V11,
-                    p.at,
-                    format!("`prob` is `{}`; expected a finite real number >= 0", p.value),
-                );
-                None
-            }
-        });
-        let time = decl.time.as_ref().and_then(|t| match t.value.parse::<u64>() {
-            Ok(n) if n > limits::MAX_TIME => {
-                report(
-                    Code::V15,
-                    t.at,
-                    format!("`time` is {n} ticks; a compiled supervisor stores at most {}", limits::MAX_TIME),
-                );
-                None
-            }
-            Ok(n) => u16::try_from(n).ok(),
-            Err(_) => {
-                report(
-                    Code::V11,
-                    t.at,
-                    format!("`time` is `{}`; expected an integer number of ticks >= 0", t.value),
-                );
-                None
-            }
-        });
+        let weight = decl
+            .prob
+            .as_ref()
+            .and_then(|p| match p.value.parse::<f64>() {
+                Ok(w) if w.is_finite() && w >= 0.0 => Some(w),
+                _ => {
+                    report(
+                        Code::V11,
+                        p.at,
+                        format!(
+                            "`prob` is `{}`; expected a finite real number >= 0",
+                            p.value
+                        ),
+                    );
+                    None
+                }
+            });
+        let time = decl
+            .time
+            .as_ref()
+            .and_then(|t| match t.value.parse::<u64>() {
+                Ok(n) if n > limits::MAX_TIME => {
+                    report(
+                        Code::V15,
+                        t.at,
+                        format!(
+                            "`time` is {n} ticks; a compiled supervisor stores at most {}",
+                            limits::MAX_TIME
+                        ),
+                    );
+                    None
+                }
+                Ok(n) => u16::try_from(n).ok(),
+                Err(_) => {
+                    report(
+                        Code::V11,
+                        t.at,
+                        format!(
+                            "`time` is `{}`; expected an integer number of ticks >= 0",
+                            t.value
+                        ),
+                    );
+                    None
+                }
+            });
         if controllable == Some(false) {
             for (key, attr) in [("prob", &decl.prob), ("time", &decl.time)] {
                 let Some(attr) = attr else { continue };
@@ -362,7 +389,8 @@ fn check_file(
             report(
                 Code::W4,
                 p.at,
-                "`prob` in a plant model is ignored (probabilities belong in specifications)".into(),
+                "`prob` in a plant model is ignored (probabilities belong in specifications)"
+                    .into(),
             );
         }
         if let Some(s) = src {
@@ -396,7 +424,11 @@ fn check_file(
             dst,
             event,
             weight: weight.filter(|_| is_controllable && weights_count),
-            time: if is_controllable { time.unwrap_or(0) } else { 0 },
+            time: if is_controllable {
+                time.unwrap_or(0)
+            } else {
+                0
+            },
         });
     }
 

@@ -113,11 +113,20 @@ pub(crate) fn parse(file: &str, text: &str) -> Result<Element, Diagnostic> {
             format!("element `<{}>` is never closed", innermost.name),
         ));
     }
-    root.ok_or_else(|| x1(index.position(text.len()), "the file has no root element".into()))
+    root.ok_or_else(|| {
+        x1(
+            index.position(text.len()),
+            "the file has no root element".into(),
+        )
+    })
 }
 
 /// Builds an element (without children) from a start tag, reading its attributes with positions.
-fn element(file: &str, index: &LineIndex<'_>, start: &BytesStart<'_>) -> Result<Element, Diagnostic> {
+fn element(
+    file: &str,
+    index: &LineIndex<'_>,
+    start: &BytesStart<'_>,
+) -> Result<Element, Diagnostic> {
     let content: &[u8] = start.as_ref();
     let tag_at = index.position_of(content);
     // The tag content starts right after `<`.

@@ -25,7 +25,10 @@ fn diagnose(files: &[&str]) -> Vec<String> {
 fn run(inputs: &[Input], options: ValidateOptions, base: &Path) -> Vec<String> {
     let validation = load(inputs, options).expect("inputs are readable");
     if validation.diagnostics.iter().any(|d| d.is_error()) {
-        assert!(validation.models.is_none(), "errors must withhold the models");
+        assert!(
+            validation.models.is_none(),
+            "errors must withhold the models"
+        );
     }
     let prefix = format!("{}/", base.display());
     validation
@@ -42,7 +45,9 @@ const W5_DONE: &str = "uncontrollable event `done` appears in no plant: it can n
 fn v1_model_without_initial_state_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v1_no_initial.xml"]),
-        ["fixtures/invalid/v1_no_initial.xml:2:1: error[V1]: model `v1_no_initial` has no initial state"]
+        [
+            "fixtures/invalid/v1_no_initial.xml:2:1: error[V1]: model `v1_no_initial` has no initial state"
+        ]
     );
 }
 
@@ -50,7 +55,9 @@ fn v1_model_without_initial_state_is_rejected() {
 fn v2_second_initial_state_is_rejected_at_its_declaration() {
     assert_eq!(
         diagnose(&["invalid/v2_two_initial.xml"]),
-        ["fixtures/invalid/v2_two_initial.xml:5:5: error[V2]: state `busy` is a second initial state (first at line 4)"]
+        [
+            "fixtures/invalid/v2_two_initial.xml:5:5: error[V2]: state `busy` is a second initial state (first at line 4)"
+        ]
     );
 }
 
@@ -58,7 +65,9 @@ fn v2_second_initial_state_is_rejected_at_its_declaration() {
 fn v3_model_without_marked_state_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v3_no_marked.xml"]),
-        ["fixtures/invalid/v3_no_marked.xml:2:1: error[V3]: model `v3_no_marked` has no marked state"]
+        [
+            "fixtures/invalid/v3_no_marked.xml:2:1: error[V3]: model `v3_no_marked` has no marked state"
+        ]
     );
 }
 
@@ -77,7 +86,9 @@ fn v4_undeclared_event_points_at_the_event_attribute() {
 fn v5_undeclared_state_points_at_the_dst_attribute() {
     assert_eq!(
         diagnose(&["invalid/v5_undeclared_state.xml"]),
-        ["fixtures/invalid/v5_undeclared_state.xml:13:28: error[V5]: transition target `done` is not declared in `<states>`"]
+        [
+            "fixtures/invalid/v5_undeclared_state.xml:13:28: error[V5]: transition target `done` is not declared in `<states>`"
+        ]
     );
 }
 
@@ -85,7 +96,9 @@ fn v5_undeclared_state_points_at_the_dst_attribute() {
 fn v6_state_used_by_no_transition_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v6_unused_state.xml"]),
-        ["fixtures/invalid/v6_unused_state.xml:6:5: error[V6]: state `broken` is used by no transition"]
+        [
+            "fixtures/invalid/v6_unused_state.xml:6:5: error[V6]: state `broken` is used by no transition"
+        ]
     );
 }
 
@@ -93,7 +106,9 @@ fn v6_state_used_by_no_transition_is_rejected() {
 fn v7_event_used_by_no_transition_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v7_unused_event.xml"]),
-        ["fixtures/invalid/v7_unused_event.xml:10:5: error[V7]: event `repair` is used by no transition"]
+        [
+            "fixtures/invalid/v7_unused_event.xml:10:5: error[V7]: event `repair` is used by no transition"
+        ]
     );
 }
 
@@ -165,7 +180,9 @@ fn v12_state_whose_controllable_weights_are_all_zero_is_rejected() {
 fn v13_missing_type_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v13_missing_type.xml"]),
-        ["fixtures/invalid/v13_missing_type.xml:2:1: error[V13]: model `x` has no `type` (expected plant or spec)"]
+        [
+            "fixtures/invalid/v13_missing_type.xml:2:1: error[V13]: model `x` has no `type` (expected plant or spec)"
+        ]
     );
 }
 
@@ -210,7 +227,9 @@ fn v13_type_must_match_the_role_given_on_the_command_line() {
 fn v14_reserved_tick_event_is_rejected() {
     assert_eq!(
         diagnose(&["invalid/v14_tick.xml"]),
-        ["fixtures/invalid/v14_tick.xml:10:12: error[V14]: event name `tick` is reserved for the global clock and must not be declared"]
+        [
+            "fixtures/invalid/v14_tick.xml:10:12: error[V14]: event name `tick` is reserved for the global clock and must not be declared"
+        ]
     );
 }
 
@@ -236,13 +255,19 @@ fn v15_more_than_255_transitions_per_state_and_256_events_are_rejected() {
     }
     xml.push_str("</events>\n<transitions>\n");
     for e in 0..257 {
-        xml.push_str(&format!("<transition src=\"s\" dst=\"s\" event=\"e{e}\"/>\n"));
+        xml.push_str(&format!(
+            "<transition src=\"s\" dst=\"s\" event=\"e{e}\"/>\n"
+        ));
     }
     xml.push_str("</transitions>\n</automata>\n");
     let path = dir.path().join("wide.xml");
     std::fs::write(&path, xml).expect("write fixture");
     assert_eq!(
-        run(&[Input::new(&path, None)], ValidateOptions::default(), dir.path()),
+        run(
+            &[Input::new(&path, None)],
+            ValidateOptions::default(),
+            dir.path()
+        ),
         [
             "wide.xml:2:9: error[V15]: state `s` has 257 outgoing transitions; a compiled supervisor allows at most 255",
             "wide.xml:260:1: error[V15]: event `e256` is event number 257 of the project; compiled supervisors \
@@ -255,18 +280,28 @@ fn v15_more_than_255_transitions_per_state_and_256_events_are_rejected() {
 fn w1_omitted_con_warns_and_means_uncontrollable() {
     assert_eq!(
         diagnose(&["invalid/w1_con_omitted.xml"]),
-        ["fixtures/invalid/w1_con_omitted.xml:9:5: warning[W1]: event `done` has no `con` attribute; it is treated as uncontrollable"]
+        [
+            "fixtures/invalid/w1_con_omitted.xml:9:5: warning[W1]: event `done` has no `con` attribute; it is treated as uncontrollable"
+        ]
     );
 }
 
 #[test]
 fn w2_unreachable_state_warns_without_stopping() {
-    let inputs = [Input::new(tests_dir().join("fixtures/invalid/w2_unreachable.xml"), None)];
+    let inputs = [Input::new(
+        tests_dir().join("fixtures/invalid/w2_unreachable.xml"),
+        None,
+    )];
     let validation = load(&inputs, ValidateOptions::default()).expect("readable");
-    assert!(validation.models.is_some(), "warnings never stop the pipeline");
+    assert!(
+        validation.models.is_some(),
+        "warnings never stop the pipeline"
+    );
     assert_eq!(
         run(&inputs, ValidateOptions::default(), &tests_dir()),
-        ["fixtures/invalid/w2_unreachable.xml:6:5: warning[W2]: state `lost` is unreachable from the initial state `idle`"]
+        [
+            "fixtures/invalid/w2_unreachable.xml:6:5: warning[W2]: state `lost` is unreachable from the initial state `idle`"
+        ]
     );
 }
 
@@ -295,9 +330,15 @@ fn w4_prob_in_plant_warns_unless_thesis_literal_probabilities() {
     let literal = ValidateOptions {
         thesis_literal_probabilities: true,
     };
-    let inputs = [Input::new(tests_dir().join("fixtures/invalid/w4_prob_in_plant.xml"), None)];
+    let inputs = [Input::new(
+        tests_dir().join("fixtures/invalid/w4_prob_in_plant.xml"),
+        None,
+    )];
     assert!(run(&inputs, literal, &tests_dir()).is_empty());
-    let models = load(&inputs, literal).expect("readable").models.expect("valid");
+    let models = load(&inputs, literal)
+        .expect("readable")
+        .models
+        .expect("valid");
     assert_eq!(models[0].transitions[0].weight, Some(0.5));
 }
 
@@ -305,7 +346,9 @@ fn w4_prob_in_plant_warns_unless_thesis_literal_probabilities() {
 fn w5_uncontrollable_event_in_no_plant_warns_at_its_declaration() {
     assert_eq!(
         diagnose(&["invalid/w5_spec_only_event.xml"]),
-        [format!("fixtures/invalid/w5_spec_only_event.xml:9:5: warning[W5]: {W5_DONE}")]
+        [format!(
+            "fixtures/invalid/w5_spec_only_event.xml:9:5: warning[W5]: {W5_DONE}"
+        )]
     );
 }
 
@@ -322,8 +365,16 @@ fn w6_plant_sharing_no_event_with_a_specification_warns_at_its_root() {
 
 #[test]
 fn errors_in_several_files_are_all_reported_at_once() {
-    let all = diagnose(&["invalid/v1_no_initial.xml", "invalid/x1_truncated.xml", "invalid/v7_unused_event.xml"]);
-    let codes: Vec<&str> = all.iter().map(|d| &d[d.find('[').unwrap_or(0)..]).map(|d| &d[1..3]).collect();
+    let all = diagnose(&[
+        "invalid/v1_no_initial.xml",
+        "invalid/x1_truncated.xml",
+        "invalid/v7_unused_event.xml",
+    ]);
+    let codes: Vec<&str> = all
+        .iter()
+        .map(|d| &d[d.find('[').unwrap_or(0)..])
+        .map(|d| &d[1..3])
+        .collect();
     assert_eq!(codes, ["V1", "V7", "X1"]);
 }
 
@@ -342,7 +393,9 @@ fn x1_mismatched_end_tag_is_located() {
 fn x1_element_never_closed_points_at_its_start_tag() {
     assert_eq!(
         diagnose(&["invalid/x1_truncated.xml"]),
-        ["fixtures/invalid/x1_truncated.xml:11:3: error[X1]: element `<transitions>` is never closed"]
+        [
+            "fixtures/invalid/x1_truncated.xml:11:3: error[X1]: element `<transitions>` is never closed"
+        ]
     );
 }
 
@@ -350,7 +403,9 @@ fn x1_element_never_closed_points_at_its_start_tag() {
 fn x1_unquoted_attribute_value_points_at_the_value() {
     assert_eq!(
         diagnose(&["invalid/x1_bad_quoting.xml"]),
-        ["fixtures/invalid/x1_bad_quoting.xml:4:17: error[X1]: malformed attribute in `<state>`: attribute value is not enclosed in quotes"]
+        [
+            "fixtures/invalid/x1_bad_quoting.xml:4:17: error[X1]: malformed attribute in `<state>`: attribute value is not enclosed in quotes"
+        ]
     );
 }
 
@@ -392,7 +447,10 @@ fn x2_unknown_attribute_and_element_are_rejected() {
 
 #[test]
 fn nadzoru_fsa_imports_without_diagnostics() {
-    let inputs = [Input::new(tests_dir().join("fixtures/nadzoru/machine.xml"), Some(ModelKind::Plant))];
+    let inputs = [Input::new(
+        tests_dir().join("fixtures/nadzoru/machine.xml"),
+        Some(ModelKind::Plant),
+    )];
     assert!(run(&inputs, ValidateOptions::default(), &tests_dir()).is_empty());
 }
 
@@ -400,13 +458,18 @@ fn nadzoru_fsa_imports_without_diagnostics() {
 fn nadzoru_fsa_needs_a_role() {
     assert_eq!(
         diagnose(&["nadzoru/machine.xml"]),
-        ["fixtures/nadzoru/machine.xml:2:1: error[V13]: Nadzoru2 model `machine` carries no type: pass it with --plant or --spec"]
+        [
+            "fixtures/nadzoru/machine.xml:2:1: error[V13]: Nadzoru2 model `machine` carries no type: pass it with --plant or --spec"
+        ]
     );
 }
 
 #[test]
 fn nadzoru_duplicate_and_unknown_ids_are_located() {
-    let inputs = [Input::new(tests_dir().join("fixtures/nadzoru/bad_ids.xml"), Some(ModelKind::Plant))];
+    let inputs = [Input::new(
+        tests_dir().join("fixtures/nadzoru/bad_ids.xml"),
+        Some(ModelKind::Plant),
+    )];
     assert_eq!(
         run(&inputs, ValidateOptions::default(), &tests_dir()),
         [
