@@ -43,7 +43,7 @@ pub fn to_dot(
     let mut out = String::new();
     // Writing into a String cannot fail.
     let _ = writeln!(out, "digraph \"{}\" {{", quote(automaton.name()));
-    out.push_str("  rankdir=LR;\n  node [shape=circle, fontname=\"Helvetica\"];\n");
+    out.push_str("  rankdir=LR;\n  fontname=\"Helvetica\";\n  node [shape=circle, fontname=\"Helvetica\"];\n");
     out.push_str("  edge [fontname=\"Helvetica\", fontsize=10];\n");
     let _ = writeln!(
         out,
@@ -183,4 +183,85 @@ pub fn write_drawing(dir: &Path, stem: &str, dot: &str) -> io::Result<Vec<PathBu
         }
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::automaton::ModelKind;
+
+    /// The generator of section 9: q0 (initial, marked) -a(0.8, T 2)-> q1, q0 -b(0.2)-> q2, q1 -a-> q1,
+    /// q1 -u-> q0, q2 -b(1)-> q0, q2 -c(3)-> q1.
+    fn example() -> (Automaton, EventTable) {
+        let mut events = EventTable::new();
+        let [a, b, c] = ["a", "b", "c"].map(|n| events.intern(n, true).unwrap());
+        let u = events.intern("u", false).unwrap();
+        let mut g = Automaton::new("example", ModelKind::Spec);
+        let q0 = g.add_state("q0", true).unwrap();
+        let q1 = g.add_state("q1", false).unwrap();
+        let q2 = g.add_state("q2", false).unwrap();
+        for (from, e, to, p, t) in [
+            (q0, a, q1, 0.8, 2),
+            (q0, b, q2, 0.2, 0),
+            (q1, a, q1, 1.0, 0),
+            (q1, u, q0, 1.0, 0),
+            (q2, b, q0, 1.0, 0),
+            (q2, c, q1, 3.0, 0),
+        ] {
+            g.add_transition(from, e, to, p, t).unwrap();
+        }
+        (g, events)
+    }
+
+    #[test]
+    fn drawing_follows_the_section_1_conventions() {
+        let (g, events) = example();
+        let marks = HashMap::from([
+            (StateId(2), StateMark::Bad),
+            (StateId(1), StateMark::Removed),
+        ]);
+        let dot = to_dot(&g, &events, &marks, ProbLabels::Stored);
+        assert!(
+            dot.contains("s0 [label=\"q0\", shape=doublecircle];"),
+            "marked state is a double circle"
+        );
+        assert!(
+            dot.contains("__start -> s0;"),
+            "initial state has an entry arrow"
+        );
+        assert!(
+            dot.contains("s1 -> s0 [label=\"u\", color=\"red:invis:red\", fontcolor=red];"),
+            "uncontrollable arcs are red double lines"
+        );
+        assert!(
+            dot.contains("s0 -> s1 [label=\"a\\nP=0.8 T=2\"];"),
+            "controllable labels show P and T"
+        );
+        assert!(
+            dot.contains("s1 -> s1 [label=\"a\"];"),
+            "P = 1 and T = 0 are not shown"
+        );
+        assert!(
+            dot.contains("s2 [label=\"q2\", style=filled, fillcolor=\"#ff9999\""),
+            "bad states are red"
+        );
+        assert!(
+            dot.contains("s1 [label=\"q1\", style=dashed, color=red"),
+            "removed states are red"
+        );
+    }
+
+    #[test]
+    fn input_weights_are_shown_normalised_per_state() {
+        let (g, events) = example();
+        let dot = to_dot(&g, &events, &HashMap::new(), ProbLabels::PerState);
+        assert!(dot.contains("s2 -> s0 [label=\"b\\nP=0.25\"];"));
+        assert!(dot.contains("s2 -> s1 [label=\"c\\nP=0.75\"];"));
+    }
+
+    #[test]
+    fn names_are_quoted_for_dot_and_files() {
+        assert_eq!(quote(r#"a"b\c"#), r#"a\"b\\c"#);
+        assert_eq!(file_stem("S_((a,b))/x"), "S___a_b___x");
+    }
 }
