@@ -332,7 +332,10 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
         generate_rust(&set, &origin(&args.project, synthesis.architecture)),
     )?;
     let report = Report::new(&synthesis, &files, bytes.len(), &diagnostics);
-    write(&out.join("report.json"), report.to_json())?;
+    write(
+        &out.join("report.json"),
+        report.to_json().context("cannot serialise the report")?,
+    )?;
     if args.draw {
         draw_synthesis(&out.join("drawings"), &synthesis)?;
     }

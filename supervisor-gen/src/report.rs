@@ -234,10 +234,9 @@ impl Report {
         }
     }
 
-    /// Pretty JSON.
-    pub fn to_json(&self) -> String {
-        // Serialising plain structs of strings and numbers cannot fail; non-finite floats become null.
-        serde_json::to_string_pretty(self).unwrap_or_default()
+    /// Pretty JSON (non-finite numbers become `null`).
+    pub fn to_json(&self) -> serde_json::Result<String> {
+        serde_json::to_string_pretty(self)
     }
 }
 
