@@ -222,6 +222,7 @@ fn validated(
 fn check(args: &CheckArgs) -> Result<Outcome> {
     let options = ValidateOptions {
         thesis_literal_probabilities: args.thesis_literal_probabilities,
+        ..ValidateOptions::default()
     };
     let inputs = check_inputs(args);
     Ok(match validated(&inputs, options)? {
@@ -236,6 +237,7 @@ fn check(args: &CheckArgs) -> Result<Outcome> {
 fn draw(args: &DrawArgs) -> Result<Outcome> {
     let options = ValidateOptions {
         thesis_literal_probabilities: args.files.thesis_literal_probabilities,
+        ..ValidateOptions::default()
     };
     let Some((models, _)) = validated(&check_inputs(&args.files), options)? else {
         return Ok(Outcome::Rejected);
@@ -264,6 +266,7 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
 fn synthesised(args: &ProjectArgs) -> Result<Option<(Synthesis, Vec<Diagnostic>)>> {
     let options = ValidateOptions {
         thesis_literal_probabilities: args.thesis_literal_probabilities,
+        raw_weights: args.raw_weights,
     };
     let Some((models, diagnostics)) = validated(&project_inputs(args), options)? else {
         return Ok(None);

@@ -28,6 +28,8 @@ pub mod limits {
 pub struct ValidateOptions {
     /// Keep plant probabilities (`--thesis-literal-probabilities`): no W4, and V12 applies to plants too.
     pub thesis_literal_probabilities: bool,
+    /// Weights are stored as written (`--raw-weights`), so a weight above 1 cannot be compiled (V15).
+    pub raw_weights: bool,
 }
 
 /// A validated state.
@@ -124,7 +126,11 @@ fn check_file(
     options: ValidateOptions,
     out: &mut Vec<Diagnostic>,
 ) -> Option<CheckedModel> {
-    let mut check = FileCheck { source, out };
+    let mut check = FileCheck {
+        source,
+        options,
+        out,
+    };
     let kind = check.kind();
     let weights_count = match kind {
         Some(ModelKind::Plant) => options.thesis_literal_probabilities,
@@ -180,6 +186,7 @@ struct Resolved {
 /// The rules of one file, reporting into `out`.
 struct FileCheck<'a> {
     source: &'a SourceModel,
+    options: ValidateOptions,
     out: &'a mut Vec<Diagnostic>,
 }
 
@@ -423,6 +430,13 @@ impl<'a> FileCheck<'a> {
     /// A `prob` value, or V11.
     fn weight(&mut self, p: &Located<String>) -> Option<f64> {
         match p.value.parse::<f64>() {
+            Ok(w) if w > 1.0 && w.is_finite() && self.options.raw_weights => {
+                let message = format!(
+                    "`prob` is {w}; with --raw-weights weights are stored as probabilities and must be at most 1"
+                );
+                self.report(Code::V15, p.at, message);
+                None
+            }
             Ok(w) if w.is_finite() && w >= 0.0 => Some(w),
             _ => {
                 let message = format!(

@@ -299,3 +299,78 @@ fn codegen_writes_the_rust_module() {
     let rust = std::fs::read_to_string(&file).expect("written");
     assert!(rust.contains("start2"));
 }
+
+#[test]
+fn weights_are_normalised_unless_raw_weights_is_given() {
+    let (m1, m2, pref) = (
+        fixture("factory/machine1.xml"),
+        fixture("factory/machine2.xml"),
+        fixture("factory/preference.xml"),
+    );
+    let start2_at_initial = |extra: &[&str]| {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut args = vec![
+            "synth",
+            "--plant",
+            path(&m1),
+            path(&m2),
+            "--spec",
+            path(&pref),
+            "--out",
+            path(dir.path()),
+        ];
+        args.extend(extra);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let xml = std::fs::read_to_string(dir.path().join("S_preference.xml")).expect("written");
+        let line = xml
+            .lines()
+            .find(|l| l.contains(r#"src="((idle,idle),any)""#) && l.contains(r#"event="start2""#))
+            .map(str::trim)
+            .map(str::to_owned);
+        line.expect("start2 is enabled initially")
+    };
+    assert!(start2_at_initial(&[]).contains(r#"prob="0.75""#));
+    assert!(start2_at_initial(&["--raw-weights"]).contains(r#"prob="0.375""#));
+}
+
+#[test]
+fn without_graphviz_only_dot_is_written_and_the_absence_is_logged_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let empty_path = tempfile::tempdir().expect("temp dir");
+    let (m1, m2, buffer) = (
+        fixture("factory/machine1.xml"),
+        fixture("factory/machine2.xml"),
+        fixture("factory/buffer.xml"),
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_supervisor-gen"))
+        .args([
+            "synth",
+            "--plant",
+            path(&m1),
+            path(&m2),
+            "--spec",
+            path(&buffer),
+            "--out",
+            path(dir.path()),
+            "--draw",
+        ])
+        .env("PATH", empty_path.path())
+        .output()
+        .expect("the binary runs");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o).matches("Graphviz `dot` is not on PATH").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
+    let drawings = dir.path().join("drawings");
+    assert!(drawings.join("S_buffer_3_K.dot").is_file());
+    let images = std::fs::read_dir(&drawings)
+        .expect("drawings dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.path().extension().is_some_and(|x| x != "dot"))
+        .count();
+    assert_eq!(images, 0);
+}

@@ -329,6 +329,7 @@ fn w4_prob_in_plant_warns_unless_thesis_literal_probabilities() {
     );
     let literal = ValidateOptions {
         thesis_literal_probabilities: true,
+        ..ValidateOptions::default()
     };
     let inputs = [Input::new(
         tests_dir().join("fixtures/invalid/w4_prob_in_plant.xml"),
@@ -490,5 +491,23 @@ fn worked_example_of_section_10_3_warns_only_about_u() {
             "fixtures/example_10_3.xml:13:5: warning[W5]: uncontrollable event `u` appears in no plant: it can never \
              make a state bad, and it is applied only when every owning supervisor allows it"
         ]
+    );
+}
+
+#[test]
+fn v15_raw_weight_above_1_cannot_be_stored() {
+    let raw = ValidateOptions {
+        raw_weights: true,
+        ..ValidateOptions::default()
+    };
+    let inputs = [Input::new(
+        tests_dir().join("fixtures/example_10_3.xml"),
+        None,
+    )];
+    let diagnostics = run(&inputs, raw, &tests_dir());
+    assert_eq!(
+        diagnostics[1],
+        "fixtures/example_10_3.xml:21:45: error[V15]: `prob` is 3; with --raw-weights weights are stored as \
+         probabilities and must be at most 1"
     );
 }

@@ -182,3 +182,72 @@ fn nadzoru_import_equals_the_same_machine_in_thesis_format() {
     from_nadzoru.set_name("machine1");
     assert_eq!(from_nadzoru, from_thesis);
 }
+
+mod generated {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A random deterministic supervisor: names with XML special characters, random controllability, positive
+    /// weights and lower bounds up to 65 535.
+    fn supervisor() -> impl Strategy<Value = (Automaton, EventTable)> {
+        let states = 1..6usize;
+        let events = prop::collection::vec(any::<bool>(), 1..5);
+        (states, events)
+            .prop_flat_map(|(n, controllable)| {
+                let edges = prop::collection::vec(
+                    (
+                        0..n,
+                        0..controllable.len(),
+                        0..n,
+                        0.001f64..10.0,
+                        0u32..=65_535,
+                    ),
+                    0..12,
+                );
+                let marked = prop::collection::vec(any::<bool>(), n);
+                (Just(controllable), edges, marked)
+            })
+            .prop_map(|(controllable, edges, marked)| {
+                let mut events = EventTable::new();
+                let ids: Vec<_> = controllable
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &c)| {
+                        events
+                            .intern(&format!("e{i}<&\"'>"), c)
+                            .expect("few events")
+                    })
+                    .collect();
+                let mut a = Automaton::new("gen & <sup>", ModelKind::Supervisor);
+                let states: Vec<_> = marked
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &m)| {
+                        a.add_state(format!("s{i} \"q\" & <x>"), m || i == 0)
+                            .expect("few states")
+                    })
+                    .collect();
+                for &id in &ids {
+                    a.add_event(id);
+                }
+                for (from, e, to, p, t) in edges {
+                    let (p, t) = if events.is_controllable(ids[e]) {
+                        (p, t)
+                    } else {
+                        (1.0, 0)
+                    };
+                    // A second edge on the same (state, event) is simply not added: automata are deterministic.
+                    let _ = a.add_transition(states[from], ids[e], states[to], p, t);
+                }
+                (a, events)
+            })
+    }
+
+    proptest! {
+        #[test]
+        fn writing_then_reading_gives_the_same_automaton((a, events) in supervisor()) {
+            let (_, back) = round_trip(&a, &events);
+            prop_assert_eq!(back, a);
+        }
+    }
+}
