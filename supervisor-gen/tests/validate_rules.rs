@@ -511,3 +511,18 @@ fn v15_raw_weight_above_1_cannot_be_stored() {
          probabilities and must be at most 1"
     );
 }
+
+#[test]
+fn x1_file_that_is_not_utf8_is_located() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("latin1.xml");
+    std::fs::write(&path, b"<automata name=\"m\"\n  type=\"pl\xe4nt\"/>").expect("write fixture");
+    assert_eq!(
+        run(
+            &[Input::new(&path, None)],
+            ValidateOptions::default(),
+            dir.path()
+        ),
+        ["latin1.xml:2:11: error[X1]: the file is not valid UTF-8 (model files must be UTF-8)"]
+    );
+}
