@@ -9,6 +9,7 @@
 
 pub mod architecture;
 pub mod automaton;
+pub mod build;
 pub mod codegen;
 pub mod compiled;
 pub mod convert;

@@ -12,12 +12,13 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use supervisor_gen::architecture::Architecture;
 use supervisor_gen::automaton::{Automaton, EventTable, ModelKind};
+use supervisor_gen::build::{BuildError, BuildRequest, Built, build};
 use supervisor_gen::codegen::generate_rust;
-use supervisor_gen::convert::{to_automata, to_project};
+use supervisor_gen::convert::to_automata;
 use supervisor_gen::diagnostics::{Diagnostic, Severity};
 use supervisor_gen::dot::{self, ProbLabels, StateMark};
 use supervisor_gen::load::{Input, load};
-use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis, SynthesisOptions, synthesize};
+use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
 use supervisor_gen::report::Report;
 use supervisor_gen::supc::RemovalReason;
 use supervisor_gen::validate::{CheckedModel, ValidateOptions};
@@ -177,18 +178,6 @@ fn check_inputs(args: &CheckArgs) -> Vec<Input> {
     typed.chain(plants).chain(specs).collect()
 }
 
-fn project_inputs(args: &ProjectArgs) -> Vec<Input> {
-    let plants = args
-        .plants
-        .iter()
-        .map(|p| Input::new(p, Some(ModelKind::Plant)));
-    let specs = args
-        .specs
-        .iter()
-        .map(|p| Input::new(p, Some(ModelKind::Spec)));
-    plants.chain(specs).collect()
-}
-
 /// Prints every diagnostic and a count line to stderr.
 fn print_diagnostics(diagnostics: &[Diagnostic]) {
     for d in diagnostics {
@@ -262,23 +251,30 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// Validates and synthesises a project; `None` (with the reason printed) if the input is invalid or impossible.
-fn synthesised(args: &ProjectArgs) -> Result<Option<(Synthesis, Vec<Diagnostic>)>> {
-    let options = ValidateOptions {
-        thesis_literal_probabilities: args.thesis_literal_probabilities,
-        raw_weights: args.raw_weights,
-    };
-    let Some((models, diagnostics)) = validated(&project_inputs(args), options)? else {
-        return Ok(None);
-    };
-    let project = to_project(&models)?;
-    let options = SynthesisOptions {
+/// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
+/// specification impossible or the result too large to compile. I/O problems are errors.
+fn built(args: &ProjectArgs) -> Result<Option<Built>> {
+    let request = BuildRequest {
+        plants: args.plants.clone(),
+        specs: args.specs.clone(),
+        architecture: args.mode.into(),
         raw_weights: args.raw_weights,
         thesis_literal_probabilities: args.thesis_literal_probabilities,
-        ..SynthesisOptions::default()
     };
-    match synthesize(&project, args.mode.into(), options) {
-        Ok(s) => Ok(Some((s, diagnostics))),
+    match build(&request) {
+        Ok(built) => {
+            print_diagnostics(&built.warnings);
+            Ok(Some(built))
+        }
+        Err(BuildError::Load(err)) => Err(err.into()),
+        Err(BuildError::Invalid(diagnostics)) => {
+            print_diagnostics(&diagnostics);
+            Ok(None)
+        }
+        Err(BuildError::Codegen(err)) => {
+            eprintln!("error[V15]: {err}");
+            Ok(None)
+        }
         Err(err) => {
             eprintln!("error: {err}");
             Ok(None)
@@ -287,15 +283,8 @@ fn synthesised(args: &ProjectArgs) -> Result<Option<(Synthesis, Vec<Diagnostic>)
 }
 
 fn codegen(args: &CodegenArgs) -> Result<Outcome> {
-    let Some((synthesis, _)) = synthesised(&args.project)? else {
+    let Some(Built { synthesis, set, .. }) = built(&args.project)? else {
         return Ok(Outcome::Rejected);
-    };
-    let set = match synthesis.compile() {
-        Ok(set) => set,
-        Err(err) => {
-            eprintln!("error[V15]: {err}");
-            return Ok(Outcome::Rejected);
-        }
     };
     let origin = origin(&args.project, synthesis.architecture);
     write(&args.out, generate_rust(&set, &origin))?;
@@ -309,15 +298,13 @@ fn codegen(args: &CodegenArgs) -> Result<Outcome> {
 }
 
 fn synth(args: &SynthArgs) -> Result<Outcome> {
-    let Some((synthesis, diagnostics)) = synthesised(&args.project)? else {
+    let Some(Built {
+        synthesis,
+        set,
+        warnings,
+    }) = built(&args.project)?
+    else {
         return Ok(Outcome::Rejected);
-    };
-    let set = match synthesis.compile() {
-        Ok(set) => set,
-        Err(err) => {
-            eprintln!("error[V15]: {err}");
-            return Ok(Outcome::Rejected);
-        }
     };
     let out = &args.out;
     create_dir(out)?;
@@ -334,7 +321,7 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
         &out.join("supervisors.rs"),
         generate_rust(&set, &origin(&args.project, synthesis.architecture)),
     )?;
-    let report = Report::new(&synthesis, &files, bytes.len(), &diagnostics);
+    let report = Report::new(&synthesis, &files, bytes.len(), &warnings);
     write(
         &out.join("report.json"),
         report.to_json().context("cannot serialise the report")?,

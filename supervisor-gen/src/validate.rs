@@ -8,20 +8,9 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::automaton::ModelKind;
+use crate::compiled::{MAX_EVENTS, MAX_STATES, MAX_TRANSITIONS_PER_STATE};
 use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
 use crate::source::{Located, SourceFormat, SourceModel, parse_kind};
-
-/// Limits of the compiled byte layout (section 9) that input models are checked against (V15).
-pub mod limits {
-    /// Most outgoing transitions of one state (1-byte count).
-    pub const MAX_TRANSITIONS_PER_STATE: usize = 255;
-    /// Most states of one model (2-byte state ids).
-    pub const MAX_STATES: usize = 65_535;
-    /// Most events in a project (1-byte event ids).
-    pub const MAX_EVENTS: usize = 256;
-    /// Largest lower bound, in ticks (2-byte values).
-    pub const MAX_TIME: u64 = 65_535;
-}
 
 /// Choices that change which rules apply.
 #[derive(Debug, Clone, Copy, Default)]
@@ -281,12 +270,12 @@ impl<'a> FileCheck<'a> {
             let message = format!("model `{}` has no marked state", self.model());
             self.report(Code::V3, source.root, message);
         }
-        if states.list.len() > limits::MAX_STATES {
+        if states.list.len() > MAX_STATES {
             let message = format!(
                 "model `{}` has {} states; a compiled supervisor holds at most {}",
                 self.model(),
                 states.list.len(),
-                limits::MAX_STATES
+                MAX_STATES
             );
             self.report(Code::V15, source.root, message);
         }
@@ -453,13 +442,11 @@ impl<'a> FileCheck<'a> {
     fn time(&mut self, t: &Located<String>) -> Option<u16> {
         match t.value.parse::<u64>() {
             Ok(n) => {
-                let fits = u16::try_from(n)
-                    .ok()
-                    .filter(|&v| u64::from(v) <= limits::MAX_TIME);
+                let fits = u16::try_from(n).ok();
                 if fits.is_none() {
                     let message = format!(
                         "`time` is {n} ticks; a compiled supervisor stores at most {}",
-                        limits::MAX_TIME
+                        u16::MAX
                     );
                     self.report(Code::V15, t.at, message);
                 }
@@ -523,11 +510,10 @@ impl<'a> FileCheck<'a> {
                 );
                 self.report(Code::V12, states.at[s], message);
             }
-            if outgoing[s] > limits::MAX_TRANSITIONS_PER_STATE {
+            if outgoing[s] > MAX_TRANSITIONS_PER_STATE {
                 let message = format!(
                     "state `{name}` has {} outgoing transitions; a compiled supervisor allows at most {}",
-                    outgoing[s],
-                    limits::MAX_TRANSITIONS_PER_STATE
+                    outgoing[s], MAX_TRANSITIONS_PER_STATE
                 );
                 self.report(Code::V15, states.at[s], message);
             }
@@ -606,14 +592,14 @@ fn check_project(sources: &[SourceModel], out: &mut Vec<Diagnostic>) {
             match first_decl.get(name) {
                 None => {
                     distinct += 1;
-                    if distinct == limits::MAX_EVENTS + 1 {
+                    if distinct == MAX_EVENTS + 1 {
                         out.push(Diagnostic::new(
                             Code::V15,
                             &source.file,
                             decl.at,
                             format!(
                                 "event `{name}` is event number {distinct} of the project; compiled supervisors address at most {}",
-                                limits::MAX_EVENTS
+                                MAX_EVENTS
                             ),
                         ));
                     }
