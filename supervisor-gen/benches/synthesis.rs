@@ -152,7 +152,7 @@ fn target(p: &Project) -> (Automaton, Automaton, Vec<StateId>) {
 fn bench_transfer_line(c: &mut Criterion) {
     let mut group = c.benchmark_group("transfer_line");
     group.sample_size(10);
-    for &(n, cap) in &[(5, 2), (6, 3), (7, 4)] {
+    for &(n, cap) in &[(5, 2), (6, 3), (6, 6)] {
         let p = transfer_line(n, cap);
         let (k, g, g_of) = target(&p);
         let s = supc(&k, &g, &g_of, &p.events);
@@ -176,11 +176,19 @@ fn bench_transfer_line(c: &mut Criterion) {
                     .state_count()
             })
         });
-        if k.state_count() < 200_000 {
-            group.bench_function(BenchmarkId::new("minimise", &label), |b| {
-                b.iter(|| black_box(minimise(&s.supervisor)).state_count())
-            });
-        }
+        group.bench_function(BenchmarkId::new("minimise", &label), |b| {
+            b.iter(|| black_box(minimise(&s.supervisor)).state_count())
+        });
+        group.bench_function(BenchmarkId::new("synthesize_monolithic", &label), |b| {
+            b.iter(|| {
+                black_box(synthesize(
+                    &p,
+                    Architecture::Monolithic,
+                    SynthesisOptions::default(),
+                ))
+                .map(|s| s.mem_cons)
+            })
+        });
     }
     group.finish();
 }
