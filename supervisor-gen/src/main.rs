@@ -235,14 +235,14 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
     create_dir(&args.out)?;
     let mut written = 0;
     for a in &automata {
-        written += draw_one(
-            &args.out,
-            &dot::file_stem(a.name()),
-            a,
-            &events,
-            &[],
-            ProbLabels::PerState,
-        )?;
+        // Weights count in specifications (and in plants only with thesis-literal probabilities); supervisors
+        // already carry the probabilities the runtime uses.
+        let probs = match a.kind() {
+            ModelKind::Spec => ProbLabels::PerState,
+            ModelKind::Plant if options.thesis_literal_probabilities => ProbLabels::PerState,
+            _ => ProbLabels::Stored,
+        };
+        written += draw_one(&args.out, &dot::file_stem(a.name()), a, &events, &[], probs)?;
     }
     println!(
         "{written} drawing file(s) written to {}",
