@@ -196,16 +196,13 @@ fn print_diagnostics(diagnostics: &[Diagnostic]) {
 }
 
 /// Loads and validates; prints diagnostics. `None` if the input is invalid.
-fn validated(
-    inputs: &[Input],
-    options: ValidateOptions,
-) -> Result<Option<(Vec<CheckedModel>, Vec<Diagnostic>)>> {
+fn validated(inputs: &[Input], options: ValidateOptions) -> Result<Option<Vec<CheckedModel>>> {
     if inputs.is_empty() {
         anyhow::bail!("no model files given");
     }
     let validation = load(inputs, options)?;
     print_diagnostics(&validation.diagnostics);
-    Ok(validation.models.map(|m| (m, validation.diagnostics)))
+    Ok(validation.models)
 }
 
 fn check(args: &CheckArgs) -> Result<Outcome> {
@@ -228,7 +225,7 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
         thesis_literal_probabilities: args.files.thesis_literal_probabilities,
         ..ValidateOptions::default()
     };
-    let Some((models, _)) = validated(&check_inputs(&args.files), options)? else {
+    let Some(models) = validated(&check_inputs(&args.files), options)? else {
         return Ok(Outcome::Rejected);
     };
     let (events, automata) = to_automata(&models)?;
