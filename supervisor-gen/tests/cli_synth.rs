@@ -374,3 +374,30 @@ fn without_graphviz_only_dot_is_written_and_the_absence_is_logged_once() {
         .count();
     assert_eq!(images, 0);
 }
+
+#[test]
+fn modular_mode_checks_non_conflict_without_local_modular_validation() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let o = synth_factory(dir.path(), "modular", &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("report.json")).expect("report"),
+    )
+    .expect("JSON");
+    assert_eq!(report["architecture"], "modular");
+    assert_eq!(
+        report["architecture_checks"]["non_conflict"]["nonblocking"],
+        true
+    );
+    assert!(report["architecture_checks"]["local_modular_validation"].is_null());
+}
+
+#[test]
+fn check_takes_nadzoru_files_with_a_role() {
+    let o = run(&["check", "--plant", path(&fixture("nadzoru/machine.xml"))]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        "1 model(s) valid"
+    );
+}
