@@ -157,30 +157,77 @@ pub fn graphviz_available() -> bool {
     })
 }
 
-/// Writes `dot` to `dir/<stem>.dot` and, when Graphviz is available, renders `<stem>.svg` and `<stem>.png` next to
-/// it. Returns every file written.
-pub fn write_drawing(dir: &Path, stem: &str, dot: &str) -> io::Result<Vec<PathBuf>> {
+/// An image format Graphviz renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics (resolution set by [`Images::dpi`]).
+    Png,
+    /// Portable document format.
+    Pdf,
+}
+
+impl ImageFormat {
+    /// The Graphviz `-T` name, also used as the file extension.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ImageFormat::Svg => "svg",
+            ImageFormat::Png => "png",
+            ImageFormat::Pdf => "pdf",
+        }
+    }
+}
+
+/// Which images to render next to each DOT file (when Graphviz is available).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Images {
+    /// Formats to render; empty for DOT only.
+    pub formats: Vec<ImageFormat>,
+    /// Resolution of raster images in dots per inch; Graphviz' default (96) when `None`.
+    pub dpi: Option<u32>,
+}
+
+impl Default for Images {
+    /// SVG and PNG at Graphviz' default resolution.
+    fn default() -> Self {
+        Images {
+            formats: vec![ImageFormat::Svg, ImageFormat::Png],
+            dpi: None,
+        }
+    }
+}
+
+/// Writes `dot` to `dir/<stem>.dot` and, when Graphviz is available, renders the requested images next to it.
+/// Returns every file written.
+pub fn write_drawing(
+    dir: &Path,
+    stem: &str,
+    dot: &str,
+    images: &Images,
+) -> io::Result<Vec<PathBuf>> {
     let dot_path = dir.join(format!("{stem}.dot"));
     std::fs::write(&dot_path, dot)?;
     let mut written = vec![dot_path.clone()];
-    if graphviz_available() {
-        for format in ["svg", "png"] {
-            let image = dir.join(format!("{stem}.{format}"));
-            let output = Command::new("dot")
-                .arg(format!("-T{format}"))
-                .arg("-o")
-                .arg(&image)
-                .arg(&dot_path)
-                .output()?;
-            if !output.status.success() {
-                return Err(io::Error::other(format!(
-                    "dot failed on {}: {}",
-                    dot_path.display(),
-                    String::from_utf8_lossy(&output.stderr).trim()
-                )));
-            }
-            written.push(image);
+    if images.formats.is_empty() || !graphviz_available() {
+        return Ok(written);
+    }
+    for format in &images.formats {
+        let image = dir.join(format!("{stem}.{}", format.as_str()));
+        let mut command = Command::new("dot");
+        command.arg(format!("-T{}", format.as_str()));
+        if let Some(dpi) = images.dpi {
+            command.arg(format!("-Gdpi={dpi}"));
         }
+        let output = command.arg("-o").arg(&image).arg(&dot_path).output()?;
+        if !output.status.success() {
+            return Err(io::Error::other(format!(
+                "dot failed on {}: {}",
+                dot_path.display(),
+                String::from_utf8_lossy(&output.stderr).trim()
+            )));
+        }
+        written.push(image);
     }
     Ok(written)
 }

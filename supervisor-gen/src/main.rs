@@ -3,6 +3,7 @@
 //! Exit codes: 0 success; 1 invalid input (any validation error) or an impossible specification; 2 usage or I/O
 //! problems. Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
 
+use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -11,12 +12,12 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use supervisor_gen::architecture::Architecture;
-use supervisor_gen::automaton::{Automaton, EventTable, ModelKind};
+use supervisor_gen::automaton::{Automaton, EventTable, ModelKind, StateId};
 use supervisor_gen::build::{BuildError, BuildRequest, Built, build};
 use supervisor_gen::codegen::generate_rust;
 use supervisor_gen::convert::to_automata;
 use supervisor_gen::diagnostics::{Diagnostic, Severity};
-use supervisor_gen::dot::{self, ProbLabels, StateMark};
+use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels, StateMark};
 use supervisor_gen::load::{Input, load};
 use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
 use supervisor_gen::report::Report;
@@ -78,6 +79,45 @@ struct SynthArgs {
     /// Also draw every input, intermediate (G, E, K, SupC) and final supervisor into DIR/drawings.
     #[arg(long)]
     draw: bool,
+    #[command(flatten)]
+    images: ImageArgs,
+}
+
+/// Image options of drawings (used only when Graphviz `dot` is on PATH; DOT files are always written).
+#[derive(Debug, Args)]
+struct ImageArgs {
+    /// Image formats rendered next to each DOT file; repeat or separate with commas.
+    #[arg(long = "image-format", value_enum, value_delimiter = ',', default_values_t = [Format::Svg, Format::Png])]
+    formats: Vec<Format>,
+    /// Resolution of PNG images in dots per inch (Graphviz' default is 96).
+    #[arg(long, value_name = "DPI")]
+    dpi: Option<u32>,
+}
+
+impl ImageArgs {
+    fn images(&self) -> Images {
+        Images {
+            formats: self.formats.iter().map(|&f| f.into()).collect(),
+            dpi: self.dpi,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Format {
+    Svg,
+    Png,
+    Pdf,
+}
+
+impl From<Format> for ImageFormat {
+    fn from(format: Format) -> Self {
+        match format {
+            Format::Svg => ImageFormat::Svg,
+            Format::Png => ImageFormat::Png,
+            Format::Pdf => ImageFormat::Pdf,
+        }
+    }
 }
 
 #[derive(Debug, Args)]
@@ -103,6 +143,8 @@ struct DrawArgs {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    #[command(flatten)]
+    images: ImageArgs,
 }
 
 #[derive(Debug, Args)]
@@ -230,6 +272,11 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
     };
     let (events, automata) = to_automata(&models)?;
     create_dir(&args.out)?;
+    let drawer = Drawer {
+        dir: &args.out,
+        events: &events,
+        images: args.images.images(),
+    };
     let mut written = 0;
     for a in &automata {
         // Weights count in specifications (and in plants only with thesis-literal probabilities); supervisors
@@ -239,7 +286,7 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
             ModelKind::Plant if options.thesis_literal_probabilities => ProbLabels::PerState,
             _ => ProbLabels::Stored,
         };
-        written += draw_one(&args.out, &dot::file_stem(a.name()), a, &events, &[], probs)?;
+        written += drawer.draw(&dot::file_stem(a.name()), a, &HashMap::new(), probs)?;
     }
     println!(
         "{written} drawing file(s) written to {}",
@@ -324,7 +371,14 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
         report.to_json().context("cannot serialise the report")?,
     )?;
     if args.draw {
-        draw_synthesis(&out.join("drawings"), &synthesis)?;
+        let dir = out.join("drawings");
+        create_dir(&dir)?;
+        let drawer = Drawer {
+            dir: &dir,
+            events,
+            images: args.images.images(),
+        };
+        draw_synthesis(&drawer, &synthesis)?;
     }
     print_summary(&synthesis, set.mem_cons(), out);
     Ok(Outcome::Success)
@@ -389,100 +443,73 @@ fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
 }
 
 /// Draws the project's inputs (once) and every stage of every supervisor.
-fn draw_synthesis(dir: &Path, synthesis: &Synthesis) -> Result<()> {
-    create_dir(dir)?;
-    let events = &synthesis.normalised.events;
+fn draw_synthesis(drawer: &Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
     let project = &synthesis.normalised;
     for a in project.plants.iter().chain(&project.specs) {
-        draw_one(
-            dir,
-            &format!("input_{}", dot::file_stem(a.name())),
-            a,
-            events,
-            &[],
+        let stem = format!("input_{}", dot::file_stem(a.name()));
+        drawer.draw(&stem, a, &HashMap::new(), ProbLabels::Stored)?;
+    }
+    for s in synthesis
+        .supervisors
+        .iter()
+        .chain(&synthesis.monolithic_reference)
+    {
+        draw_stages(drawer, s)?;
+    }
+    Ok(())
+}
+
+/// G, E, K (with the removed states marked), SupC before minimisation, and the final supervisor.
+fn draw_stages(drawer: &Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
+    let stem = dot::file_stem(&s.name);
+    let removed: HashMap<StateId, StateMark> = s
+        .removed
+        .iter()
+        .map(|r| match r.reason {
+            RemovalReason::Bad { .. } => (r.state, StateMark::Bad),
+            _ => (r.state, StateMark::Removed),
+        })
+        .collect();
+    let none = HashMap::new();
+    let stages = [
+        ("1_G", &s.plant, &none),
+        ("2_E", &s.spec, &none),
+        ("3_K", &s.target, &removed),
+        ("4_supc", &s.unminimised, &none),
+        ("5_final", &s.supervisor, &none),
+    ];
+    for (stage, automaton, marks) in stages {
+        drawer.draw(
+            &format!("{stem}_{stage}"),
+            automaton,
+            marks,
             ProbLabels::Stored,
         )?;
     }
-    let all = synthesis
-        .supervisors
-        .iter()
-        .chain(&synthesis.monolithic_reference);
-    for s in all {
-        draw_stages(dir, s, events)?;
+    Ok(())
+}
+
+/// Writes drawings of automata over one event table into one directory.
+struct Drawer<'a> {
+    dir: &'a Path,
+    events: &'a EventTable,
+    images: Images,
+}
+
+impl Drawer<'_> {
+    /// Writes one drawing; returns the number of files written.
+    fn draw(
+        &self,
+        stem: &str,
+        a: &Automaton,
+        marks: &HashMap<StateId, StateMark>,
+        probs: ProbLabels,
+    ) -> Result<usize> {
+        let text = dot::to_dot(a, self.events, marks, probs);
+        let written = dot::write_drawing(self.dir, stem, &text, &self.images)
+            .with_context(|| format!("cannot write drawing {stem} in {}", self.dir.display()))?;
+        Ok(written.len())
     }
-    Ok(())
-}
-
-fn draw_stages(dir: &Path, s: &SupervisorSynthesis, events: &EventTable) -> Result<()> {
-    let stem = dot::file_stem(&s.name);
-    let marks: Vec<_> = s
-        .removed
-        .iter()
-        .map(|r| {
-            let mark = match r.reason {
-                RemovalReason::Bad { .. } => StateMark::Bad,
-                _ => StateMark::Removed,
-            };
-            (r.state, mark)
-        })
-        .collect();
-    draw_one(
-        dir,
-        &format!("{stem}_1_G"),
-        &s.plant,
-        events,
-        &[],
-        ProbLabels::Stored,
-    )?;
-    draw_one(
-        dir,
-        &format!("{stem}_2_E"),
-        &s.spec,
-        events,
-        &[],
-        ProbLabels::Stored,
-    )?;
-    draw_one(
-        dir,
-        &format!("{stem}_3_K"),
-        &s.target,
-        events,
-        &marks,
-        ProbLabels::Stored,
-    )?;
-    draw_one(
-        dir,
-        &format!("{stem}_4_supc"),
-        &s.unminimised,
-        events,
-        &[],
-        ProbLabels::Stored,
-    )?;
-    draw_one(
-        dir,
-        &format!("{stem}_5_final"),
-        &s.supervisor,
-        events,
-        &[],
-        ProbLabels::Stored,
-    )?;
-    Ok(())
-}
-
-/// Writes one drawing; returns the number of files written.
-fn draw_one(
-    dir: &Path,
-    stem: &str,
-    a: &Automaton,
-    events: &EventTable,
-    marks: &[(supervisor_gen::automaton::StateId, StateMark)],
-    probs: ProbLabels,
-) -> Result<usize> {
-    let marks = marks.iter().copied().collect();
-    let text = dot::to_dot(a, events, &marks, probs);
-    let written = dot::write_drawing(dir, stem, &text)
-        .with_context(|| format!("cannot write drawing {stem} in {}", dir.display()))?;
-    Ok(written.len())
 }
 
 fn create_dir(dir: &Path) -> Result<()> {

@@ -401,3 +401,23 @@ fn check_takes_nadzoru_files_with_a_role() {
         "1 model(s) valid"
     );
 }
+
+#[test]
+fn image_formats_are_configurable() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let o = run(&[
+        "draw",
+        path(&fixture("example_10_3.xml")),
+        "--out",
+        path(dir.path()),
+        "--image-format",
+        "pdf,png",
+        "--dpi",
+        "50",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(dir.path().join("example.dot").is_file());
+    assert_eq!(dir.path().join("example.pdf").is_file(), graphviz_on_path());
+    assert_eq!(dir.path().join("example.png").is_file(), graphviz_on_path());
+    assert!(!dir.path().join("example.svg").exists());
+}
