@@ -25,9 +25,9 @@ pub fn minimise(a: &Automaton) -> Automaton {
     let mut tail = Vec::with_capacity(m);
     let mut head = Vec::with_capacity(m);
     let mut label = Vec::with_capacity(m);
-    for (x, list) in a.out.iter().enumerate() {
-        for t in list {
-            tail.push(x as u32);
+    for x in a.states() {
+        for t in a.transitions(x) {
+            tail.push(x.0);
             head.push(t.target.0);
             label.push(
                 (u64::from(t.event.0) << 48)
@@ -54,7 +54,7 @@ pub fn minimise(a: &Automaton) -> Automaton {
     let mut marks = Marks::new(n.max(m) + 1);
     let mut blocks = Partition::new(n);
     for x in 0..n {
-        if a.marked[x] {
+        if a.is_marked(StateId(x as u32)) {
             blocks.mark(x, &mut marks);
         }
     }
@@ -212,18 +212,12 @@ fn quotient(a: &Automaton, class: &[u32], classes: usize) -> Automaton {
     }
     for &x in &rep {
         let x = StateId(x);
-        r.state_names.push(a.state_name(x).to_owned());
-        r.marked.push(a.is_marked(x));
-        r.out.push(
-            a.transitions(x)
-                .iter()
-                .map(|t| {
-                    let mut t = *t;
-                    t.target = StateId(class[t.target.index()]);
-                    t
-                })
-                .collect(),
-        );
+        let merged = a.transitions(x).iter().map(|t| {
+            let mut t = *t;
+            t.target = StateId(class[t.target.index()]);
+            t
+        });
+        r.push_state(a.state_name(x), a.is_marked(x), merged);
     }
     r.initial = StateId(class[a.initial().index()]);
     r

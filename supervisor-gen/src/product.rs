@@ -80,6 +80,7 @@ pub fn product_with_tuples(
     let mut cur = vec![0u32; arity];
     let mut next = vec![0u32; arity];
     let mut buf: Vec<Transition> = Vec::new();
+    let mut name = String::new();
     let mut x = 0usize;
     while x < index.len() {
         cur.copy_from_slice(index.tuple(x));
@@ -121,37 +122,23 @@ pub fn product_with_tuples(
             }
         }
         buf.sort_unstable_by_key(|t| t.event);
-        result.out.push(buf.clone());
+        name.clear();
+        if arity == 1 {
+            name.push_str(parts[0].state_name(StateId(cur[0])));
+        } else {
+            name.push('(');
+            for (i, (&q, p)) in cur.iter().zip(parts).enumerate() {
+                if i > 0 {
+                    name.push(',');
+                }
+                name.push_str(p.state_name(StateId(q)));
+            }
+            name.push(')');
+        }
+        let marked = cur.iter().zip(parts).all(|(&s, p)| p.is_marked(StateId(s)));
+        result.push_state(&name, marked, buf.iter().copied());
         x += 1;
     }
-    let n = index.len();
-    result.marked = (0..n)
-        .map(|x| {
-            index
-                .tuple(x)
-                .iter()
-                .zip(parts)
-                .all(|(&s, p)| p.is_marked(StateId(s)))
-        })
-        .collect();
-    result.state_names = (0..n)
-        .map(|x| {
-            let t = index.tuple(x);
-            if arity == 1 {
-                parts[0].state_name(StateId(t[0])).to_owned()
-            } else {
-                let mut s = String::from("(");
-                for (i, (&q, p)) in t.iter().zip(parts).enumerate() {
-                    if i > 0 {
-                        s.push(',');
-                    }
-                    s.push_str(p.state_name(StateId(q)));
-                }
-                s.push(')');
-                s
-            }
-        })
-        .collect();
     result.initial = StateId(0);
     ProductOutput {
         automaton: result,
