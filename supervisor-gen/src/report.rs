@@ -27,8 +27,8 @@ pub struct Report {
     pub mem_cons: MemConsReport,
     /// Non-conflict and local-modular validation.
     pub architecture_checks: ArchitectureChecks,
-    /// Every validation warning, rendered as printed.
-    pub warnings: Vec<String>,
+    /// Every validation warning (code, severity, file, line, column, message).
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// One supervisor.
@@ -229,7 +229,7 @@ impl Report {
             warnings: diagnostics
                 .iter()
                 .filter(|d| !d.is_error())
-                .map(ToString::to_string)
+                .cloned()
                 .collect(),
         }
     }

@@ -421,3 +421,37 @@ fn image_formats_are_configurable() {
     assert_eq!(dir.path().join("example.png").is_file(), graphviz_on_path());
     assert!(!dir.path().join("example.svg").exists());
 }
+
+#[test]
+fn report_lists_validation_warnings_with_their_locations() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (m1, m2, spec) = (
+        fixture("factory/machine1.xml"),
+        fixture("factory/machine2.xml"),
+        fixture("example_10_3.xml"),
+    );
+    // The worked example's events a, b, c, u belong to no plant: W5 for `u`, W6 for both machines.
+    let o = run(&[
+        "synth",
+        "--plant",
+        path(&m1),
+        path(&m2),
+        "--spec",
+        path(&spec),
+        "--out",
+        path(dir.path()),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("report.json")).expect("report"),
+    )
+    .expect("JSON");
+    let warnings = report["warnings"].as_array().expect("list");
+    let codes: Vec<&str> = warnings.iter().filter_map(|w| w["code"].as_str()).collect();
+    assert_eq!(codes, ["W5", "W6", "W6"]);
+    assert_eq!(
+        (warnings[0]["line"].as_u64(), warnings[0]["column"].as_u64()),
+        (Some(13), Some(5))
+    );
+    assert_eq!(warnings[0]["severity"], "warning");
+}
