@@ -20,7 +20,9 @@ pub enum ConvertError {
         source: ModelError,
     },
     /// A supervisor file was given where only plants and specifications make sense.
-    #[error("model `{model}` in {file} is a supervisor; synthesis takes only plants and specifications")]
+    #[error(
+        "model `{model}` in {file} is a supervisor; synthesis takes only plants and specifications"
+    )]
     SupervisorInProject {
         /// The model name.
         model: String,
@@ -30,7 +32,10 @@ pub enum ConvertError {
 }
 
 /// Builds the automaton of one validated model, interning its events into `events`.
-pub fn to_automaton(model: &CheckedModel, events: &mut EventTable) -> Result<Automaton, ConvertError> {
+pub fn to_automaton(
+    model: &CheckedModel,
+    events: &mut EventTable,
+) -> Result<Automaton, ConvertError> {
     let wrap = |source| ConvertError::Model {
         model: model.name.clone(),
         source,

@@ -228,7 +228,10 @@ mod tests {
         let d = Diagnostic::new(
             Code::V8,
             "models/e1.xml",
-            Position { line: 12, column: 5 },
+            Position {
+                line: 12,
+                column: 5,
+            },
             "state `s1` has two transitions on event `go` (first at line 9)",
         );
         assert_eq!(

@@ -9,6 +9,7 @@
 
 pub mod architecture;
 pub mod automaton;
+pub mod build;
 pub mod codegen;
 pub mod compiled;
 pub mod convert;
@@ -20,6 +21,7 @@ mod nadzoru;
 pub mod normalise;
 pub mod pipeline;
 pub mod product;
+pub mod report;
 pub mod source;
 pub mod supc;
 pub mod trim;

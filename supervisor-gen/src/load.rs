@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::automaton::ModelKind;
-use crate::diagnostics;
+use crate::diagnostics::{self, Code, Diagnostic, LineIndex};
 use crate::validate::{ValidateOptions, Validation, validate};
 use crate::xml_read::read_model;
 
@@ -31,7 +31,7 @@ impl Input {
 
 /// A model file could not be read.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot read {path}: {source}")]
+#[error("cannot read {path}")]
 pub struct LoadError {
     /// The file.
     pub path: String,
@@ -45,10 +45,17 @@ pub fn load(inputs: &[Input], options: ValidateOptions) -> Result<Validation, Lo
     let mut sources = Vec::new();
     for input in inputs {
         let name = display(&input.path);
-        let text = std::fs::read_to_string(&input.path).map_err(|source| LoadError {
+        let bytes = std::fs::read(&input.path).map_err(|source| LoadError {
             path: name.clone(),
             source,
         })?;
+        let text = match String::from_utf8(bytes) {
+            Ok(text) => text,
+            Err(err) => {
+                read_problems.push(not_utf8(&name, err.as_bytes(), err.utf8_error()));
+                continue;
+            }
+        };
         match read_model(&name, &text, input.role) {
             Ok(source) => sources.push(source),
             Err(mut problems) => read_problems.append(&mut problems),
@@ -61,6 +68,18 @@ pub fn load(inputs: &[Input], options: ValidateOptions) -> Result<Validation, Lo
         validation.models = None;
     }
     Ok(validation)
+}
+
+/// An `X1` diagnostic at the first byte that is not UTF-8.
+fn not_utf8(file: &str, bytes: &[u8], err: std::str::Utf8Error) -> Diagnostic {
+    let valid = err.valid_up_to();
+    let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+    Diagnostic::new(
+        Code::X1,
+        file,
+        LineIndex::new(prefix).position(valid),
+        "the file is not valid UTF-8 (model files must be UTF-8)",
+    )
 }
 
 fn display(path: &Path) -> String {

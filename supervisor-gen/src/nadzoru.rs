@@ -8,8 +8,8 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use crate::diagnostics::{Code, Diagnostic, Position};
 use crate::automaton::ModelKind;
+use crate::diagnostics::{Code, Diagnostic, Position};
 use crate::source::{EventDecl, Located, SourceFormat, SourceModel, StateDecl, TransitionDecl};
 use crate::xml_read::Shape;
 use crate::xml_tree::Element;
@@ -25,11 +25,15 @@ pub(crate) fn import(
         Some(t) if t.value == "FSA" => {}
         Some(t) => shape.x2(
             t.at,
-            format!("Nadzoru2 model type is `{}`; only `FSA` can be imported", t.value),
+            format!(
+                "Nadzoru2 model type is `{}`; only `FSA` can be imported",
+                t.value
+            ),
         ),
         None => shape.x2(
             root.at,
-            "`<model>` lacks the required attribute `type` (Nadzoru2 files say type=\"FSA\")".into(),
+            "`<model>` lacks the required attribute `type` (Nadzoru2 files say type=\"FSA\")"
+                .into(),
         ),
     }
     let stem = Path::new(file)
@@ -60,7 +64,10 @@ pub(crate) fn import(
         if data.name != "data" {
             shape.x2(
                 data.at,
-                format!("unexpected `<{}>` in a Nadzoru2 `<model>` (expected `<data>`)", data.name),
+                format!(
+                    "unexpected `<{}>` in a Nadzoru2 `<model>` (expected `<data>`)",
+                    data.name
+                ),
             );
             continue;
         }
@@ -170,7 +177,10 @@ fn resolve(
             shape.report(
                 unknown,
                 id.at,
-                format!("transition {key} refers to {what} id `{}`, which no {what} declares", id.value),
+                format!(
+                    "transition {key} refers to {what} id `{}`, which no {what} declares",
+                    id.value
+                ),
             );
             None
         }

@@ -7,27 +7,18 @@
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
-use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
 use crate::automaton::ModelKind;
+use crate::compiled::{MAX_EVENTS, MAX_STATES, MAX_TRANSITIONS_PER_STATE};
+use crate::diagnostics::{Code, Diagnostic, Position, has_errors};
 use crate::source::{Located, SourceFormat, SourceModel, parse_kind};
-
-/// Limits of the compiled byte layout (section 9) that input models are checked against (V15).
-pub mod limits {
-    /// Most outgoing transitions of one state (1-byte count).
-    pub const MAX_TRANSITIONS_PER_STATE: usize = 255;
-    /// Most states of one model (2-byte state ids).
-    pub const MAX_STATES: usize = 65_535;
-    /// Most events in a project (1-byte event ids).
-    pub const MAX_EVENTS: usize = 256;
-    /// Largest lower bound, in ticks (2-byte values).
-    pub const MAX_TIME: u64 = 65_535;
-}
 
 /// Choices that change which rules apply.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ValidateOptions {
     /// Keep plant probabilities (`--thesis-literal-probabilities`): no W4, and V12 applies to plants too.
     pub thesis_literal_probabilities: bool,
+    /// Weights are stored as written (`--raw-weights`), so a weight above 1 cannot be compiled (V15).
+    pub raw_weights: bool,
 }
 
 /// A validated state.
@@ -115,10 +106,7 @@ pub fn validate(sources: &[SourceModel], options: ValidateOptions) -> Validation
 
 /// The kind a model is treated as: its declared type if valid.
 fn declared_kind(source: &SourceModel) -> Option<ModelKind> {
-    source
-        .kind
-        .as_ref()
-        .and_then(|k| parse_kind(&k.value))
+    source.kind.as_ref().and_then(|k| parse_kind(&k.value))
 }
 
 /// Per-file rules. Returns the typed model when the file could be resolved (errors may still have been reported).
@@ -127,363 +115,427 @@ fn check_file(
     options: ValidateOptions,
     out: &mut Vec<Diagnostic>,
 ) -> Option<CheckedModel> {
-    let file = source.file.as_str();
-    let mut report =
-        |code: Code, at: Position, message: String| out.push(Diagnostic::new(code, file, at, message));
-
-    // V13: type.
-    let kind = match &source.kind {
-        None => {
-            let message = match source.format {
-                SourceFormat::Thesis => {
-                    format!("model `{}` has no `type` (expected plant or spec)", source.name.value)
-                }
-                SourceFormat::Nadzoru => format!(
-                    "Nadzoru2 model `{}` carries no type: pass it with --plant or --spec",
-                    source.name.value
-                ),
-            };
-            report(Code::V13, source.root, message);
-            None
-        }
-        Some(k) => match parse_kind(&k.value) {
-            None => {
-                report(
-                    Code::V13,
-                    k.at,
-                    format!(
-                        "unknown model type `{}` (expected plant, spec, free-behaviour, specification or supervisor)",
-                        k.value
-                    ),
-                );
-                None
-            }
-            Some(kind) => {
-                if let Some(role) = source.role.filter(|&r| r != kind) {
-                    report(
-                        Code::V13,
-                        k.at,
-                        format!("model `{}` declares type `{kind}` but was passed as --{role}", source.name.value),
-                    );
-                }
-                Some(kind)
-            }
-        },
+    let mut check = FileCheck {
+        source,
+        options,
+        out,
     };
+    let kind = check.kind();
     let weights_count = match kind {
         Some(ModelKind::Plant) => options.thesis_literal_probabilities,
         _ => true,
     };
-
-    // States: V9, V2, V1, V3, V15.
-    let mut state_index: HashMap<&str, usize> = HashMap::new();
-    let mut state_at: Vec<Position> = Vec::new();
-    let mut states = Vec::new();
-    let mut first_initial: Option<Position> = None;
-    let mut any_marked = false;
-    for decl in &source.states {
-        if let Some(&first) = state_index.get(decl.name.value.as_str()) {
-            report(
-                Code::V9,
-                decl.name.at,
-                format!(
-                    "duplicate state name `{}` (first at line {})",
-                    decl.name.value, state_at[first].line
-                ),
-            );
-            continue;
-        }
-        if decl.initial {
-            match first_initial {
-                Some(first) => report(
-                    Code::V2,
-                    decl.at,
-                    format!(
-                        "state `{}` is a second initial state (first at line {})",
-                        decl.name.value, first.line
-                    ),
-                ),
-                None => first_initial = Some(decl.at),
-            }
-        }
-        any_marked |= decl.marked;
-        state_index.insert(&decl.name.value, states.len());
-        state_at.push(decl.at);
-        states.push(CheckedState {
-            name: decl.name.value.clone(),
-            initial: decl.initial && first_initial == Some(decl.at),
-            marked: decl.marked,
-        });
+    let states = check.states();
+    let events = check.events();
+    let transitions = check.transitions(&states, &events, kind, weights_count);
+    if kind != Some(ModelKind::Supervisor) {
+        // A supervisor's alphabet is meaningful even for events it never enables (they stay disabled at runtime),
+        // so tool output is exempt from V6 and V7.
+        check.unused(&states, &events, &transitions);
     }
-    if first_initial.is_none() {
-        report(
-            Code::V1,
-            source.root,
-            format!("model `{}` has no initial state", source.name.value),
-        );
-    }
-    if !any_marked {
-        report(
-            Code::V3,
-            source.root,
-            format!("model `{}` has no marked state", source.name.value),
-        );
-    }
-    if states.len() > limits::MAX_STATES {
-        report(
-            Code::V15,
-            source.root,
-            format!(
-                "model `{}` has {} states; a compiled supervisor holds at most {}",
-                source.name.value,
-                states.len(),
-                limits::MAX_STATES
-            ),
-        );
-    }
-
-    // Events: V9, V14, W1.
-    let mut event_index: HashMap<&str, usize> = HashMap::new();
-    let mut event_at: Vec<Position> = Vec::new();
-    let mut events = Vec::new();
-    for decl in &source.events {
-        if let Some(&first) = event_index.get(decl.name.value.as_str()) {
-            report(
-                Code::V9,
-                decl.name.at,
-                format!(
-                    "duplicate event name `{}` (first at line {})",
-                    decl.name.value, event_at[first].line
-                ),
-            );
-            continue;
-        }
-        if decl.name.value == "tick" {
-            report(
-                Code::V14,
-                decl.name.at,
-                "event name `tick` is reserved for the global clock and must not be declared".into(),
-            );
-        }
-        if decl.controllable.is_none() {
-            report(
-                Code::W1,
-                decl.at,
-                format!(
-                    "event `{}` has no `con` attribute; it is treated as uncontrollable",
-                    decl.name.value
-                ),
-            );
-        }
-        event_index.insert(&decl.name.value, events.len());
-        event_at.push(decl.at);
-        events.push(CheckedEvent {
-            name: decl.name.value.clone(),
-            controllable: decl.controllable.unwrap_or(false),
-        });
-    }
-
-    // Transitions: V4, V5, V8, V11, V15, W3, W4.
-    let mut transitions = Vec::new();
-    let mut first_on: HashMap<(usize, usize), Position> = HashMap::new();
-    let mut used_states = vec![false; states.len()];
-    let mut used_events = vec![false; events.len()];
-    let mut complete = true;
-    for decl in &source.transitions {
-        let event = event_index.get(decl.event.value.as_str()).copied();
-        if event.is_none() {
-            report(
-                Code::V4,
-                decl.event.at,
-                format!("transition uses event `{}`, which is not declared in `<events>`", decl.event.value),
-            );
-        }
-        let state = |name: &Located<String>, role: &str, report: &mut dyn FnMut(Code, Position, String)| {
-            let found = state_index.get(name.value.as_str()).copied();
-            if found.is_none() {
-                report(
-                    Code::V5,
-                    name.at,
-                    format!("transition {role} `{}` is not declared in `<states>`", name.value),
-                );
-            }
-            found
-        };
-        let src = state(&decl.src, "source", &mut report);
-        let dst = state(&decl.dst, "target", &mut report);
-        let controllable = event.map(|e| events[e].controllable);
-        let weight = decl.prob.as_ref().and_then(|p| match p.value.parse::<f64>() {
-            Ok(w) if w.is_finite() && w >= 0.0 => Some(w),
-            _ => {
-                report(
-                    Code::V11,
-                    p.at,
-                    format!("`prob` is `{}`; expected a finite real number >= 0", p.value),
-                );
-                None
-            }
-        });
-        let time = decl.time.as_ref().and_then(|t| match t.value.parse::<u64>() {
-            Ok(n) if n > limits::MAX_TIME => {
-                report(
-                    Code::V15,
-                    t.at,
-                    format!("`time` is {n} ticks; a compiled supervisor stores at most {}", limits::MAX_TIME),
-                );
-                None
-            }
-            Ok(n) => u16::try_from(n).ok(),
-            Err(_) => {
-                report(
-                    Code::V11,
-                    t.at,
-                    format!("`time` is `{}`; expected an integer number of ticks >= 0", t.value),
-                );
-                None
-            }
-        });
-        if controllable == Some(false) {
-            for (key, attr) in [("prob", &decl.prob), ("time", &decl.time)] {
-                let Some(attr) = attr else { continue };
-                report(
-                    Code::W3,
-                    attr.at,
-                    format!(
-                        "`{key}` on a transition of uncontrollable event `{}` is ignored",
-                        decl.event.value
-                    ),
-                );
-            }
-        } else if controllable == Some(true)
-            && kind == Some(ModelKind::Plant)
-            && !weights_count
-            && let Some(p) = &decl.prob
-        {
-            report(
-                Code::W4,
-                p.at,
-                "`prob` in a plant model is ignored (probabilities belong in specifications)".into(),
-            );
-        }
-        if let Some(s) = src {
-            used_states[s] = true;
-        }
-        if let Some(d) = dst {
-            used_states[d] = true;
-        }
-        if let Some(e) = event {
-            used_events[e] = true;
-        }
-        let (Some(src), Some(dst), Some(event)) = (src, dst, event) else {
-            complete = false;
-            continue;
-        };
-        if let Some(first) = first_on.get(&(src, event)) {
-            report(
-                Code::V8,
-                decl.at,
-                format!(
-                    "state `{}` has two transitions on event `{}` (first at line {})",
-                    states[src].name, events[event].name, first.line
-                ),
-            );
-            continue;
-        }
-        first_on.insert((src, event), decl.at);
-        let is_controllable = events[event].controllable;
-        transitions.push(CheckedTransition {
-            src,
-            dst,
-            event,
-            weight: weight.filter(|_| is_controllable && weights_count),
-            time: if is_controllable { time.unwrap_or(0) } else { 0 },
-        });
-    }
-
-    // V6, V7. A supervisor's alphabet is meaningful even for events it never enables (they stay disabled at
-    // runtime), so tool output is exempt.
-    let is_supervisor = kind == Some(ModelKind::Supervisor);
-    for (s, used) in used_states.iter().enumerate() {
-        if !used && !is_supervisor {
-            report(
-                Code::V6,
-                state_at[s],
-                format!("state `{}` is used by no transition", states[s].name),
-            );
-        }
-    }
-    for (e, used) in used_events.iter().enumerate() {
-        if !used && !is_supervisor {
-            report(
-                Code::V7,
-                event_at[e],
-                format!("event `{}` is used by no transition", events[e].name),
-            );
-        }
-    }
-
-    // V12 and V15 per state.
-    let mut outgoing = vec![0usize; states.len()];
-    let mut controllable_out = vec![(0usize, false); states.len()];
-    for t in &transitions {
-        outgoing[t.src] += 1;
-        if events[t.event].controllable {
-            let entry = &mut controllable_out[t.src];
-            entry.0 += 1;
-            entry.1 |= t.weight.unwrap_or(1.0) > 0.0;
-        }
-    }
-    for (s, &(count, positive)) in controllable_out.iter().enumerate() {
-        if weights_count && count > 0 && !positive {
-            report(
-                Code::V12,
-                state_at[s],
-                format!(
-                    "all {count} outgoing controllable transitions of state `{}` have weight 0",
-                    states[s].name
-                ),
-            );
-        }
-        if outgoing[s] > limits::MAX_TRANSITIONS_PER_STATE {
-            report(
-                Code::V15,
-                state_at[s],
-                format!(
-                    "state `{}` has {} outgoing transitions; a compiled supervisor allows at most {}",
-                    states[s].name,
-                    outgoing[s],
-                    limits::MAX_TRANSITIONS_PER_STATE
-                ),
-            );
-        }
-    }
-
-    // W2: reachability from the single initial state; unused states already have V6.
-    if let Some(initial) = states.iter().position(|s| s.initial) {
-        let reached = reachable(initial, states.len(), &transitions);
-        for (s, reached) in reached.iter().enumerate() {
-            if !reached && used_states[s] {
-                report(
-                    Code::W2,
-                    state_at[s],
-                    format!(
-                        "state `{}` is unreachable from the initial state `{}`",
-                        states[s].name, states[initial].name
-                    ),
-                );
-            }
-        }
-    }
-
+    check.per_state(&states, &events, &transitions, weights_count);
+    check.reachability(&states, &transitions);
     let kind = kind?;
-    complete.then(|| CheckedModel {
+    transitions.complete.then(|| CheckedModel {
         file: source.file.clone(),
         name: source.name.value.clone(),
         kind,
-        states,
-        events,
-        transitions,
+        states: states.list,
+        events: events.list,
+        transitions: transitions.list,
     })
+}
+
+/// Declared names of one kind (states or events) with their positions, duplicates dropped.
+struct Declared<'a, T> {
+    index: HashMap<&'a str, usize>,
+    at: Vec<Position>,
+    list: Vec<T>,
+}
+
+impl<T> Declared<'_, T> {
+    fn new() -> Self {
+        Declared {
+            index: HashMap::new(),
+            at: Vec::new(),
+            list: Vec::new(),
+        }
+    }
+}
+
+/// Transitions of one file, with what they use.
+struct Resolved {
+    list: Vec<CheckedTransition>,
+    used_states: Vec<bool>,
+    used_events: Vec<bool>,
+    /// Every transition resolved (no V4, V5 or V8).
+    complete: bool,
+}
+
+/// The rules of one file, reporting into `out`.
+struct FileCheck<'a> {
+    source: &'a SourceModel,
+    options: ValidateOptions,
+    out: &'a mut Vec<Diagnostic>,
+}
+
+impl<'a> FileCheck<'a> {
+    fn report(&mut self, code: Code, at: Position, message: String) {
+        self.out
+            .push(Diagnostic::new(code, &self.source.file, at, message));
+    }
+
+    fn model(&self) -> &'a str {
+        &self.source.name.value
+    }
+
+    /// V13: a known `type` that agrees with the role the file was passed with.
+    fn kind(&mut self) -> Option<ModelKind> {
+        let source = self.source;
+        let Some(k) = &source.kind else {
+            let message = match source.format {
+                SourceFormat::Thesis => {
+                    format!(
+                        "model `{}` has no `type` (expected plant or spec)",
+                        self.model()
+                    )
+                }
+                SourceFormat::Nadzoru => format!(
+                    "Nadzoru2 model `{}` carries no type: pass it with --plant or --spec",
+                    self.model()
+                ),
+            };
+            self.report(Code::V13, source.root, message);
+            return None;
+        };
+        let Some(kind) = parse_kind(&k.value) else {
+            let message = format!(
+                "unknown model type `{}` (expected plant, spec, free-behaviour, specification or supervisor)",
+                k.value
+            );
+            self.report(Code::V13, k.at, message);
+            return None;
+        };
+        if let Some(role) = source.role.filter(|&r| r != kind) {
+            let message = format!(
+                "model `{}` declares type `{kind}` but was passed as --{role}",
+                self.model()
+            );
+            self.report(Code::V13, k.at, message);
+        }
+        Some(kind)
+    }
+
+    /// V9, V2, V1, V3 and the state-count limit of V15.
+    fn states(&mut self) -> Declared<'a, CheckedState> {
+        let source = self.source;
+        let mut states = Declared::new();
+        let mut first_initial: Option<Position> = None;
+        for decl in &source.states {
+            if let Some(&first) = states.index.get(decl.name.value.as_str()) {
+                let message = format!(
+                    "duplicate state name `{}` (first at line {})",
+                    decl.name.value, states.at[first].line
+                );
+                self.report(Code::V9, decl.name.at, message);
+                continue;
+            }
+            let mut initial = decl.initial;
+            if initial {
+                match first_initial {
+                    Some(first) => {
+                        let message = format!(
+                            "state `{}` is a second initial state (first at line {})",
+                            decl.name.value, first.line
+                        );
+                        self.report(Code::V2, decl.at, message);
+                        initial = false;
+                    }
+                    None => first_initial = Some(decl.at),
+                }
+            }
+            states.index.insert(&decl.name.value, states.list.len());
+            states.at.push(decl.at);
+            states.list.push(CheckedState {
+                name: decl.name.value.clone(),
+                initial,
+                marked: decl.marked,
+            });
+        }
+        if first_initial.is_none() {
+            let message = format!("model `{}` has no initial state", self.model());
+            self.report(Code::V1, source.root, message);
+        }
+        if !states.list.iter().any(|s| s.marked) {
+            let message = format!("model `{}` has no marked state", self.model());
+            self.report(Code::V3, source.root, message);
+        }
+        if states.list.len() > MAX_STATES {
+            let message = format!(
+                "model `{}` has {} states; a compiled supervisor holds at most {}",
+                self.model(),
+                states.list.len(),
+                MAX_STATES
+            );
+            self.report(Code::V15, source.root, message);
+        }
+        states
+    }
+
+    /// V9, V14, W1.
+    fn events(&mut self) -> Declared<'a, CheckedEvent> {
+        let mut events = Declared::new();
+        for decl in &self.source.events {
+            if let Some(&first) = events.index.get(decl.name.value.as_str()) {
+                let message = format!(
+                    "duplicate event name `{}` (first at line {})",
+                    decl.name.value, events.at[first].line
+                );
+                self.report(Code::V9, decl.name.at, message);
+                continue;
+            }
+            if decl.name.value == "tick" {
+                let message =
+                    "event name `tick` is reserved for the global clock and must not be declared"
+                        .into();
+                self.report(Code::V14, decl.name.at, message);
+            }
+            if decl.controllable.is_none() {
+                let message = format!(
+                    "event `{}` has no `con` attribute; it is treated as uncontrollable",
+                    decl.name.value
+                );
+                self.report(Code::W1, decl.at, message);
+            }
+            events.index.insert(&decl.name.value, events.list.len());
+            events.at.push(decl.at);
+            events.list.push(CheckedEvent {
+                name: decl.name.value.clone(),
+                controllable: decl.controllable.unwrap_or(false),
+            });
+        }
+        events
+    }
+
+    /// V4, V5, V8, V11, the lower-bound limit of V15, W3, W4.
+    fn transitions(
+        &mut self,
+        states: &Declared<'_, CheckedState>,
+        events: &Declared<'_, CheckedEvent>,
+        kind: Option<ModelKind>,
+        weights_count: bool,
+    ) -> Resolved {
+        let mut resolved = Resolved {
+            list: Vec::new(),
+            used_states: vec![false; states.list.len()],
+            used_events: vec![false; events.list.len()],
+            complete: true,
+        };
+        let mut first_on: HashMap<(usize, usize), Position> = HashMap::new();
+        for decl in &self.source.transitions {
+            let event = events.index.get(decl.event.value.as_str()).copied();
+            if event.is_none() {
+                let message = format!(
+                    "transition uses event `{}`, which is not declared in `<events>`",
+                    decl.event.value
+                );
+                self.report(Code::V4, decl.event.at, message);
+            }
+            let src = self.state(states, &decl.src, "source");
+            let dst = self.state(states, &decl.dst, "target");
+            let weight = decl.prob.as_ref().and_then(|p| self.weight(p));
+            let time = decl.time.as_ref().and_then(|t| self.time(t));
+            match event.map(|e| events.list[e].controllable) {
+                Some(false) => {
+                    for (key, attr) in [("prob", &decl.prob), ("time", &decl.time)] {
+                        if let Some(attr) = attr {
+                            let message = format!(
+                                "`{key}` on a transition of uncontrollable event `{}` is ignored",
+                                decl.event.value
+                            );
+                            self.report(Code::W3, attr.at, message);
+                        }
+                    }
+                }
+                Some(true) if kind == Some(ModelKind::Plant) && !weights_count => {
+                    if let Some(p) = &decl.prob {
+                        let message =
+                            "`prob` in a plant model is ignored (probabilities belong in specifications)".into();
+                        self.report(Code::W4, p.at, message);
+                    }
+                }
+                _ => {}
+            }
+            for s in [src, dst].into_iter().flatten() {
+                resolved.used_states[s] = true;
+            }
+            if let Some(e) = event {
+                resolved.used_events[e] = true;
+            }
+            let (Some(src), Some(dst), Some(event)) = (src, dst, event) else {
+                resolved.complete = false;
+                continue;
+            };
+            if let Some(first) = first_on.get(&(src, event)) {
+                let message = format!(
+                    "state `{}` has two transitions on event `{}` (first at line {})",
+                    states.list[src].name, events.list[event].name, first.line
+                );
+                self.report(Code::V8, decl.at, message);
+                resolved.complete = false;
+                continue;
+            }
+            first_on.insert((src, event), decl.at);
+            let controllable = events.list[event].controllable;
+            resolved.list.push(CheckedTransition {
+                src,
+                dst,
+                event,
+                weight: weight.filter(|_| controllable && weights_count),
+                time: if controllable { time.unwrap_or(0) } else { 0 },
+            });
+        }
+        resolved
+    }
+
+    /// The index of a state named by a transition, or V5.
+    fn state(
+        &mut self,
+        states: &Declared<'_, CheckedState>,
+        name: &Located<String>,
+        role: &str,
+    ) -> Option<usize> {
+        let found = states.index.get(name.value.as_str()).copied();
+        if found.is_none() {
+            let message = format!(
+                "transition {role} `{}` is not declared in `<states>`",
+                name.value
+            );
+            self.report(Code::V5, name.at, message);
+        }
+        found
+    }
+
+    /// A `prob` value, or V11.
+    fn weight(&mut self, p: &Located<String>) -> Option<f64> {
+        match p.value.parse::<f64>() {
+            Ok(w) if w > 1.0 && w.is_finite() && self.options.raw_weights => {
+                let message = format!(
+                    "`prob` is {w}; with --raw-weights weights are stored as probabilities and must be at most 1"
+                );
+                self.report(Code::V15, p.at, message);
+                None
+            }
+            Ok(w) if w.is_finite() && w >= 0.0 => Some(w),
+            _ => {
+                let message = format!(
+                    "`prob` is `{}`; expected a finite real number >= 0",
+                    p.value
+                );
+                self.report(Code::V11, p.at, message);
+                None
+            }
+        }
+    }
+
+    /// A `time` value, or V11 / V15.
+    fn time(&mut self, t: &Located<String>) -> Option<u16> {
+        match t.value.parse::<u64>() {
+            Ok(n) => {
+                let fits = u16::try_from(n).ok();
+                if fits.is_none() {
+                    let message = format!(
+                        "`time` is {n} ticks; a compiled supervisor stores at most {}",
+                        u16::MAX
+                    );
+                    self.report(Code::V15, t.at, message);
+                }
+                fits
+            }
+            Err(_) => {
+                let message = format!(
+                    "`time` is `{}`; expected an integer number of ticks >= 0",
+                    t.value
+                );
+                self.report(Code::V11, t.at, message);
+                None
+            }
+        }
+    }
+
+    /// V6, V7.
+    fn unused(
+        &mut self,
+        states: &Declared<'_, CheckedState>,
+        events: &Declared<'_, CheckedEvent>,
+        transitions: &Resolved,
+    ) {
+        for (s, used) in transitions.used_states.iter().enumerate() {
+            if !used {
+                let message = format!("state `{}` is used by no transition", states.list[s].name);
+                self.report(Code::V6, states.at[s], message);
+            }
+        }
+        for (e, used) in transitions.used_events.iter().enumerate() {
+            if !used {
+                let message = format!("event `{}` is used by no transition", events.list[e].name);
+                self.report(Code::V7, events.at[e], message);
+            }
+        }
+    }
+
+    /// V12 and the transitions-per-state limit of V15.
+    fn per_state(
+        &mut self,
+        states: &Declared<'_, CheckedState>,
+        events: &Declared<'_, CheckedEvent>,
+        transitions: &Resolved,
+        weights_count: bool,
+    ) {
+        let mut outgoing = vec![0usize; states.list.len()];
+        let mut controllable = vec![(0usize, false); states.list.len()];
+        for t in &transitions.list {
+            outgoing[t.src] += 1;
+            if events.list[t.event].controllable {
+                let (count, positive) = &mut controllable[t.src];
+                *count += 1;
+                *positive |= t.weight.unwrap_or(1.0) > 0.0;
+            }
+        }
+        for (s, &(count, positive)) in controllable.iter().enumerate() {
+            let name = &states.list[s].name;
+            if weights_count && count > 0 && !positive {
+                let message = format!(
+                    "all {count} outgoing controllable transitions of state `{name}` have weight 0"
+                );
+                self.report(Code::V12, states.at[s], message);
+            }
+            if outgoing[s] > MAX_TRANSITIONS_PER_STATE {
+                let message = format!(
+                    "state `{name}` has {} outgoing transitions; a compiled supervisor allows at most {}",
+                    outgoing[s], MAX_TRANSITIONS_PER_STATE
+                );
+                self.report(Code::V15, states.at[s], message);
+            }
+        }
+    }
+
+    /// W2: states unreachable from the single initial state (states without transitions already have V6).
+    fn reachability(&mut self, states: &Declared<'_, CheckedState>, transitions: &Resolved) {
+        let Some(initial) = states.list.iter().position(|s| s.initial) else {
+            return;
+        };
+        let reached = reachable(initial, states.list.len(), &transitions.list);
+        for (s, reached) in reached.iter().enumerate() {
+            if !reached && transitions.used_states[s] {
+                let message = format!(
+                    "state `{}` is unreachable from the initial state `{}`",
+                    states.list[s].name, states.list[initial].name
+                );
+                self.report(Code::W2, states.at[s], message);
+            }
+        }
+    }
 }
 
 /// States reachable from `initial` along `transitions`.
@@ -540,14 +592,14 @@ fn check_project(sources: &[SourceModel], out: &mut Vec<Diagnostic>) {
             match first_decl.get(name) {
                 None => {
                     distinct += 1;
-                    if distinct == limits::MAX_EVENTS + 1 {
+                    if distinct == MAX_EVENTS + 1 {
                         out.push(Diagnostic::new(
                             Code::V15,
                             &source.file,
                             decl.at,
                             format!(
                                 "event `{name}` is event number {distinct} of the project; compiled supervisors address at most {}",
-                                limits::MAX_EVENTS
+                                MAX_EVENTS
                             ),
                         ));
                     }

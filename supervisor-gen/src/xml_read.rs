@@ -4,9 +4,9 @@
 //! The reader only checks the document shape (codes `X1`, `X2`): known elements and attributes, required
 //! attributes, flag values. Children may come in any order. Every rule about the model itself is left to `validate`.
 
+use crate::automaton::ModelKind;
 use crate::diagnostics::{Code, Diagnostic, Position};
 use crate::nadzoru;
-use crate::automaton::ModelKind;
 use crate::source::{EventDecl, Located, SourceFormat, SourceModel, StateDecl, TransitionDecl};
 use crate::xml_tree::{self, Element};
 
@@ -114,7 +114,11 @@ impl<'a> Shape<'a> {
         if let Some(text) = &element.text {
             self.x2(
                 text.at,
-                format!("unexpected text `{}` inside `<{}>`", text.value.trim(), element.name),
+                format!(
+                    "unexpected text `{}` inside `<{}>`",
+                    text.value.trim(),
+                    element.name
+                ),
             );
         }
     }
@@ -202,7 +206,10 @@ fn read_thesis(
             for grandchild in &child.children {
                 shape.x2(
                     grandchild.at,
-                    format!("`<{}>` must be empty, found `<{}>`", child.name, grandchild.name),
+                    format!(
+                        "`<{}>` must be empty, found `<{}>`",
+                        child.name, grandchild.name
+                    ),
                 );
             }
         }

@@ -113,11 +113,20 @@ pub(crate) fn parse(file: &str, text: &str) -> Result<Element, Diagnostic> {
             format!("element `<{}>` is never closed", innermost.name),
         ));
     }
-    root.ok_or_else(|| x1(index.position(text.len()), "the file has no root element".into()))
+    root.ok_or_else(|| {
+        x1(
+            index.position(text.len()),
+            "the file has no root element".into(),
+        )
+    })
 }
 
 /// Builds an element (without children) from a start tag, reading its attributes with positions.
-fn element(file: &str, index: &LineIndex<'_>, start: &BytesStart<'_>) -> Result<Element, Diagnostic> {
+fn element(
+    file: &str,
+    index: &LineIndex<'_>,
+    start: &BytesStart<'_>,
+) -> Result<Element, Diagnostic> {
     let content: &[u8] = start.as_ref();
     let tag_at = index.position_of(content);
     // The tag content starts right after `<`.
@@ -130,18 +139,18 @@ fn element(file: &str, index: &LineIndex<'_>, start: &BytesStart<'_>) -> Result<
     let mut attrs = Vec::new();
     for attr in start.attributes() {
         let attr = attr.map_err(|e| {
-            let rel = match e {
-                AttrError::ExpectedEq(p)
-                | AttrError::ExpectedValue(p)
-                | AttrError::UnquotedValue(p)
-                | AttrError::ExpectedQuote(p, _)
-                | AttrError::Duplicated(p, _) => p,
+            let (rel, what) = match e {
+                AttrError::ExpectedEq(p) => (p, "attribute name is not followed by `=`"),
+                AttrError::ExpectedValue(p) => (p, "attribute has no value after `=`"),
+                AttrError::UnquotedValue(p) => (p, "attribute value is not enclosed in quotes"),
+                AttrError::ExpectedQuote(p, _) => (p, "attribute value has no closing quote"),
+                AttrError::Duplicated(p, _) => (p, "attribute appears twice"),
             };
             Diagnostic::new(
                 Code::X1,
                 file,
                 index.position(base + rel),
-                format!("malformed attribute in `<{name}>`: {e}"),
+                format!("malformed attribute in `<{name}>`: {what}"),
             )
         })?;
         let key_at = index.position_of(attr.key.as_ref());
