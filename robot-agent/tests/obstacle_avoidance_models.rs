@@ -195,3 +195,28 @@ fn sct_walk_supervisor_grows_to_six_states_and_memcons_189_bytes() {
     // s = 8, t = 21, t_c = 17, e = 10, N = 2: (8 + 63) + 2 (8 + 34) + 10 + 12 * 2.
     assert_eq!(s.compile().unwrap().mem_cons(), 189);
 }
+
+#[test]
+fn compiled_file_written_by_the_toolchain_loads_as_the_same_set_as_the_model_folder() {
+    let m = |f: &str| models("ptsct").join(f);
+    let built = supervisor_gen::build::build(&supervisor_gen::build::BuildRequest {
+        plants: vec![m("G_prox.xml"), m("G_motor.xml")],
+        specs: vec![m("E_walk.xml"), m("E_avoid.xml")],
+        architecture: Architecture::LocalModular,
+        raw_weights: false,
+        thesis_literal_probabilities: false,
+    })
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let compiled = dir.path().join("supervisors.ptsct");
+    built.set.write(&compiled).unwrap();
+    let from_file = robot_agent::supervisors::load(&[compiled]).unwrap();
+    let from_models = robot_agent::supervisors::load(&[
+        m("G_prox.xml"),
+        m("G_motor.xml"),
+        m("E_walk.xml"),
+        m("E_avoid.xml"),
+    ])
+    .unwrap();
+    assert_eq!(from_file, from_models);
+}
