@@ -28,7 +28,7 @@ fn bench_element(c: &mut Criterion, label: &str, element: &str) {
         b.iter(|| {
             tick += 1;
             // An obstacle every 8th tick, as a robot in a sparse arena sees one now and then.
-            let frame = &frames[usize::from(tick % 8 == 0)];
+            let frame = &frames[usize::from(tick.is_multiple_of(8))];
             control.step(black_box(frame), &mut command);
             black_box(&command);
         })
