@@ -1,5 +1,147 @@
-//! `robot-agent`: one robot's process.
+//! `robot-agent`: one robot's process. Loads and checks its controller before the first tick, so every startup
+//! failure (unknown controller or profile, bad supervisor file, unbound event, bad parameter) exits non-zero with
+//! the reason for the launcher to report; then joins the run and answers every tick: wait for the frame, step
+//! the controller, send the command.
 
-fn main() {
-    println!("robot-agent: not yet implemented");
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, anyhow};
+use clap::Parser;
+use robot_agent::control::{self, Control};
+use robot_agent::controller;
+use robot_agent::from_config;
+use robot_agent::params::Params;
+use swarm_runtime::config::Experiment;
+use swarm_runtime::messages::ActuatorCommand;
+use swarm_runtime::transport::{AgentLink, RunSpec};
+use tracing::{debug, info};
+
+/// One robot of a swarm run.
+#[derive(Debug, Parser)]
+#[command(name = "robot-agent", version)]
+struct Args {
+    /// Run name (shared by every process of the run).
+    #[arg(long)]
+    run: String,
+    /// iceoryx2 root directory of the run (absolute).
+    #[arg(long, required_unless_present = "check")]
+    root: Option<PathBuf>,
+    /// Index of this robot in the run (0..N).
+    #[arg(long)]
+    robot: u32,
+    /// Run seed; the player's random stream is derived from it and the robot index. Default: the
+    /// configuration's `random_seed`, or 0 without --config.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Experiment configuration (.argos); the robot runs the controller its `<e-puck>` names.
+    #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
+    config: Option<PathBuf>,
+    /// Without --config: controller element name, as a `<controllers>` child would be named.
+    #[arg(long, default_value = "")]
+    element: String,
+    /// Without --config: operational-procedure profile (with --supervisors).
+    #[arg(long, requires = "supervisors")]
+    profile: Option<String>,
+    /// Without --config: comma-separated XML model files, one folder of them, or one compiled supervisor-set file
+    /// (with --profile), relative to the working directory.
+    #[arg(long, requires = "profile")]
+    supervisors: Option<String>,
+    /// Without --config: controller parameter, as an attribute of <params> (repeatable), e.g. --param velocity=5.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    params: Vec<(String, String)>,
+    /// Load, synthesise and bind the controller, then exit without joining the run.
+    #[arg(long)]
+    check: bool,
+}
+
+fn parse_param(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, value)) if !name.is_empty() => Ok((name.to_owned(), value.to_owned())),
+        _ => Err(format!("`{s}` is not NAME=VALUE")),
+    }
+}
+
+/// Plans and builds the robot's controller from the configuration or from the manual flags.
+fn build_control(args: &Args) -> Result<Control> {
+    if let Some(path) = &args.config {
+        let (experiment, warnings) =
+            Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
+        for w in &warnings {
+            debug!("{w}");
+        }
+        let seed = match (args.seed, experiment.framework.random_seed) {
+            (Some(seed), _) | (None, Some(seed)) => seed,
+            (None, None) => anyhow::bail!(
+                "{}: random_seed is left to the clock; pass the run's seed with --seed",
+                path.display()
+            ),
+        };
+        let controller = from_config::controller_of(&experiment, args.robot)?;
+        let (plan, control) = from_config::build(&experiment, controller, seed, args.robot)?;
+        info!(
+            controller = controller.id.as_str(),
+            seed, "robot runs {plan}"
+        );
+        return Ok(control);
+    }
+    let mut pairs = args.params.clone();
+    if let (Some(profile), Some(supervisors)) = (&args.profile, &args.supervisors) {
+        pairs.push(("profile".to_owned(), profile.clone()));
+        pairs.push(("supervisors".to_owned(), supervisors.clone()));
+    }
+    let params = Params::new(pairs);
+    let base_dir = std::env::current_dir().context("cannot resolve relative paths")?;
+    let plan = controller::plan(&args.element, &params, &base_dir)?;
+    let seed = args.seed.unwrap_or(0);
+    let control = control::build(&plan, &params, seed, args.robot)?;
+    info!(seed, "robot runs {plan}");
+    Ok(control)
+}
+
+/// Answers every tick of the run until the world ends it.
+fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<()> {
+    let run = RunSpec::new(&args.run, root)?;
+    let mut link = AgentLink::join(&run, args.robot)?;
+    info!(
+        run = args.run.as_str(),
+        robot = args.robot,
+        "joined the run"
+    );
+    // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
+    let mut command = ActuatorCommand::idle(args.robot, 0);
+    while let Some(tick) = link.next_tick().context("waiting for a tick")? {
+        control.step(tick.frame(), &mut command);
+        link.answer(tick, &command).context("answering a tick")?;
+    }
+    info!(robot = args.robot, "the world ended the run");
+    Ok(())
+}
+
+fn run(args: &Args) -> Result<()> {
+    let mut control = build_control(args)
+        .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
+    let Some(root) = args.root.as_deref().filter(|_| !args.check) else {
+        info!(robot = args.robot, "controller checked");
+        return Ok(());
+    };
+    serve(args, root, &mut control)
+        .with_context(|| format!("robot {} in run {}", args.robot, args.run))
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(&Args::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
 }

@@ -398,7 +398,7 @@ mod tests {
         let a = ev.intern("a", true).unwrap();
         let x = chain("x", &[a], true);
         let mut y = chain("y", &[a], true);
-        y.out[0][0].lower_bound = 3;
+        y.transitions_mut(StateId(0))[0].lower_bound = 3;
         let cmp = compare_languages(&ev, &x, &y);
         assert_eq!(cmp.label_mismatches.len(), 1);
         assert_eq!(cmp.label_mismatches[0].second, (1.0, 3));

@@ -206,17 +206,24 @@ pub struct Transition {
 }
 
 /// A deterministic ptSCT generator `(Q, Σ, δ, q0, Qm, P, T)` (section 2).
+///
+/// Storage is flat so that million-state products cost no per-state allocation: all state names live in one
+/// string, and all transitions in one vector grouped by source state (compressed sparse rows), each group sorted
+/// by event id.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Automaton {
     pub(crate) name: String,
     pub(crate) kind: ModelKind,
     /// Sorted, deduplicated alphabet.
     pub(crate) alphabet: Vec<EventId>,
-    pub(crate) state_names: Vec<String>,
-    pub(crate) marked: Vec<bool>,
+    /// All state names, concatenated; state x's name ends at `name_end[x]`.
+    names: String,
+    name_end: Vec<usize>,
+    marked: Vec<bool>,
     pub(crate) initial: StateId,
-    /// Per state, outgoing transitions sorted by event id, at most one per event.
-    pub(crate) out: Vec<Vec<Transition>>,
+    /// Transitions of state x are `trans[first[x]..first[x + 1]]`; `first` has one entry more than there are states.
+    first: Vec<usize>,
+    trans: Vec<Transition>,
 }
 
 impl Automaton {
@@ -226,20 +233,46 @@ impl Automaton {
             name: name.into(),
             kind,
             alphabet: Vec::new(),
-            state_names: Vec::new(),
+            names: String::new(),
+            name_end: Vec::new(),
             marked: Vec::new(),
             initial: StateId(0),
-            out: Vec::new(),
+            first: vec![0],
+            trans: Vec::new(),
         }
     }
 
     /// The identity of the synchronous product (rule C3): one marked state and an empty alphabet.
     pub fn identity(name: impl Into<String>, kind: ModelKind) -> Self {
         let mut a = Self::new(name, kind);
-        a.state_names.push("id".to_owned());
-        a.marked.push(true);
-        a.out.push(Vec::new());
+        a.push_state("id", true, []);
         a
+    }
+
+    /// Appends a state with its outgoing transitions, which must be sorted by event id and target existing or
+    /// later-appended states. Used by the algorithms, which build automata state by state.
+    pub(crate) fn push_state(
+        &mut self,
+        name: &str,
+        marked: bool,
+        transitions: impl IntoIterator<Item = Transition>,
+    ) {
+        self.names.push_str(name);
+        self.name_end.push(self.names.len());
+        self.marked.push(marked);
+        self.trans.extend(transitions);
+        self.first.push(self.trans.len());
+    }
+
+    /// Mutable access to one state's transitions (labels only: event and target order must be kept).
+    pub(crate) fn transitions_mut(&mut self, state: StateId) -> &mut [Transition] {
+        let i = state.index();
+        &mut self.trans[self.first[i]..self.first[i + 1]]
+    }
+
+    /// Mutable access to every transition (labels only).
+    pub(crate) fn all_transitions_mut(&mut self) -> &mut [Transition] {
+        &mut self.trans
     }
 
     /// Adds a state and returns its id. Ids are dense and assigned in insertion order.
@@ -248,13 +281,11 @@ impl Automaton {
         name: impl Into<String>,
         marked: bool,
     ) -> Result<StateId, ModelError> {
-        let id = u32::try_from(self.state_names.len()).map_err(|_| ModelError::TooManyStates {
+        let id = u32::try_from(self.marked.len()).map_err(|_| ModelError::TooManyStates {
             automaton: self.name.clone(),
             limit: u32::MAX as usize,
         })?;
-        self.state_names.push(name.into());
-        self.marked.push(marked);
-        self.out.push(Vec::new());
+        self.push_state(&name.into(), marked, []);
         Ok(StateId(id))
     }
 
@@ -278,16 +309,17 @@ impl Automaton {
     ) -> Result<(), ModelError> {
         self.check_state(to)?;
         self.check_state(from)?;
-        let list = &mut self.out[from.index()];
-        match list.binary_search_by_key(&event, |t| t.event) {
+        let (lo, hi) = (self.first[from.index()], self.first[from.index() + 1]);
+        match self.trans[lo..hi].binary_search_by_key(&event, |t| t.event) {
             Ok(_) => Err(ModelError::Nondeterministic {
                 automaton: self.name.clone(),
-                state: self.state_names[from.index()].clone(),
+                state: self.state_name(from).to_owned(),
                 event: event.0,
             }),
             Err(pos) => {
-                list.insert(
-                    pos,
+                // Builders add few transitions; shifting the later rows keeps the storage flat.
+                self.trans.insert(
+                    lo + pos,
                     Transition {
                         event,
                         target: to,
@@ -295,6 +327,9 @@ impl Automaton {
                         lower_bound,
                     },
                 );
+                for f in &mut self.first[from.index() + 1..] {
+                    *f += 1;
+                }
                 self.add_event(event);
                 Ok(())
             }
@@ -316,7 +351,7 @@ impl Automaton {
     }
 
     fn check_state(&self, state: StateId) -> Result<(), ModelError> {
-        if state.index() < self.state_names.len() {
+        if state.index() < self.marked.len() {
             Ok(())
         } else {
             Err(ModelError::UnknownState {
@@ -358,32 +393,34 @@ impl Automaton {
 
     /// Number of states |Q|.
     pub fn state_count(&self) -> usize {
-        self.state_names.len()
+        self.marked.len()
     }
 
     /// Total number of transitions.
     pub fn transition_count(&self) -> usize {
-        self.out.iter().map(Vec::len).sum()
+        self.trans.len()
     }
 
     /// All state ids in ascending order.
     pub fn states(&self) -> impl Iterator<Item = StateId> + '_ {
-        (0..self.state_names.len()).map(|i| StateId(i as u32))
+        (0..self.marked.len()).map(|i| StateId(i as u32))
     }
 
     /// The name of a state (`"?"` for an unknown id).
     pub fn state_name(&self, state: StateId) -> &str {
-        self.state_names
-            .get(state.index())
-            .map_or("?", String::as_str)
+        let i = state.index();
+        match self.name_end.get(i) {
+            Some(&end) => {
+                let start = if i == 0 { 0 } else { self.name_end[i - 1] };
+                &self.names[start..end]
+            }
+            None => "?",
+        }
     }
 
     /// The id of the state with this name, by linear search.
     pub fn state_by_name(&self, name: &str) -> Option<StateId> {
-        self.state_names
-            .iter()
-            .position(|n| n == name)
-            .map(|i| StateId(i as u32))
+        self.states().find(|&s| self.state_name(s) == name)
     }
 
     /// Whether a state is marked (`false` for an unknown id).
@@ -398,7 +435,12 @@ impl Automaton {
 
     /// Outgoing transitions of a state, sorted by event id (empty for an unknown id).
     pub fn transitions(&self, state: StateId) -> &[Transition] {
-        self.out.get(state.index()).map_or(&[], Vec::as_slice)
+        let i = state.index();
+        if i < self.marked.len() {
+            &self.trans[self.first[i]..self.first[i + 1]]
+        } else {
+            &[]
+        }
     }
 
     /// δ(state, event) with its labels, if defined.
@@ -461,5 +503,32 @@ mod tests {
         ));
         assert_eq!(g.transition(q0, EventId(1)).map(|t| t.lower_bound), Some(2));
         assert_eq!(g.transition_count(), 2);
+    }
+
+    #[test]
+    fn adding_to_an_earlier_state_keeps_later_rows_and_names() {
+        let mut g = Automaton::new("g", ModelKind::Spec);
+        let s: Vec<_> = ["alpha", "", "gamma"]
+            .iter()
+            .map(|n| g.add_state(*n, false).unwrap())
+            .collect();
+        g.add_transition(s[2], EventId(0), s[0], 1.0, 0).unwrap();
+        g.add_transition(s[1], EventId(1), s[2], 1.0, 0).unwrap();
+        g.add_transition(s[0], EventId(2), s[1], 1.0, 0).unwrap();
+        let rows: Vec<Vec<(u16, u32)>> = g
+            .states()
+            .map(|x| {
+                g.transitions(x)
+                    .iter()
+                    .map(|t| (t.event.0, t.target.0))
+                    .collect()
+            })
+            .collect();
+        assert_eq!(rows, vec![vec![(2, 1)], vec![(1, 2)], vec![(0, 0)]]);
+        let names: Vec<_> = g.states().map(|x| g.state_name(x)).collect();
+        assert_eq!(names, vec!["alpha", "", "gamma"]);
+        assert_eq!(g.state_by_name("gamma"), Some(s[2]));
+        assert_eq!(g.state_name(StateId(7)), "?");
+        assert!(g.transitions(StateId(7)).is_empty());
     }
 }

@@ -1050,7 +1050,7 @@ mod tests {
     #[test]
     fn v15_lower_bound_over_65535_is_a_codegen_error() {
         let (ev, mut g) = worked_example();
-        g.out[0][0].lower_bound = 70_000;
+        g.transitions_mut(StateId(0))[0].lower_bound = 70_000;
         assert!(matches!(
             SupervisorSet::from_supervisors(&ev, &[g]),
             Err(CodegenError::LowerBoundTooLarge { bound: 70_000, .. })
@@ -1088,7 +1088,7 @@ mod tests {
     #[test]
     fn raw_weight_above_one_cannot_be_encoded() {
         let (ev, mut g) = worked_example();
-        g.out[2][1].prob = 3.0;
+        g.transitions_mut(StateId(2))[1].prob = 3.0;
         assert!(matches!(
             SupervisorSet::from_supervisors(&ev, &[g]),
             Err(CodegenError::ProbabilityOutOfRange { .. })

@@ -9,10 +9,23 @@
 
 pub mod architecture;
 pub mod automaton;
+pub mod build;
+pub mod codegen;
 pub mod compiled;
+pub mod convert;
+pub mod diagnostics;
+pub mod dot;
+pub mod load;
 pub mod minimise;
+mod nadzoru;
 pub mod normalise;
 pub mod pipeline;
 pub mod product;
+pub mod report;
+pub mod source;
 pub mod supc;
 pub mod trim;
+pub mod validate;
+pub mod xml_read;
+mod xml_tree;
+pub mod xml_write;

@@ -1,5 +1,521 @@
-//! `supervisor-gen` command line.
+//! `supervisor-gen` command line: validate, synthesise, draw and compile ptSCT supervisors.
+//!
+//! Exit codes: 0 success; 1 invalid input (any validation error) or an impossible specification; 2 usage or I/O
+//! problems. Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
 
-fn main() {
-    println!("supervisor-gen: not yet implemented");
+use std::collections::HashMap;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use supervisor_gen::architecture::Architecture;
+use supervisor_gen::automaton::{Automaton, EventTable, ModelKind, StateId};
+use supervisor_gen::build::{BuildError, BuildRequest, Built, build};
+use supervisor_gen::codegen::generate_rust;
+use supervisor_gen::convert::to_automata;
+use supervisor_gen::diagnostics::{Diagnostic, Severity};
+use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels, StateMark};
+use supervisor_gen::load::{Input, load};
+use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
+use supervisor_gen::report::Report;
+use supervisor_gen::supc::RemovalReason;
+use supervisor_gen::validate::{CheckedModel, ValidateOptions};
+use supervisor_gen::xml_write::to_xml;
+
+/// ptSCT toolchain: validate plant and specification automata, synthesise, minimise, draw and compile supervisors.
+///
+/// Model files are plain paths (no globs): the thesis XML format (`<automata>`) or Nadzoru2 FSA files
+/// (`<model type="FSA">`), told apart by their root element.
+/// Exit codes: 0 success, 1 invalid input or impossible specification, 2 usage or I/O error.
+#[derive(Debug, Parser)]
+#[command(name = "supervisor-gen", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Validate, synthesise and write supervisors XML, supervisors.ptsct, supervisors.rs, report.json (and drawings).
+    Synth(SynthArgs),
+    /// Validate model files only and print every diagnostic.
+    Check(CheckArgs),
+    /// Draw model files as DOT (and SVG/PNG when Graphviz `dot` is on PATH).
+    Draw(DrawArgs),
+    /// Synthesise and write only the generated Rust module.
+    Codegen(CodegenArgs),
+}
+
+/// The models of a project.
+#[derive(Debug, Args)]
+struct ProjectArgs {
+    /// Plant (free-behaviour) model files; repeat the flag or list several paths.
+    #[arg(long = "plant", value_name = "FILE", num_args = 1.., required = true)]
+    plants: Vec<PathBuf>,
+    /// Specification model files; repeat the flag or list several paths.
+    #[arg(long = "spec", value_name = "FILE", num_args = 1.., required = true)]
+    specs: Vec<PathBuf>,
+    /// Supervisor architecture (section 6.6).
+    #[arg(long, value_enum, default_value_t = Mode::LocalModular)]
+    mode: Mode,
+    /// Keep specification weights as written (no input normalisation, no monolithic renormalisation).
+    #[arg(long)]
+    raw_weights: bool,
+    /// Keep plant probabilities as factors (compatibility with the thesis' literal composition rule, A5).
+    #[arg(long)]
+    thesis_literal_probabilities: bool,
+}
+
+#[derive(Debug, Args)]
+struct SynthArgs {
+    #[command(flatten)]
+    project: ProjectArgs,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Also draw every input, intermediate (G, E, K, SupC) and final supervisor into DIR/drawings.
+    #[arg(long)]
+    draw: bool,
+    #[command(flatten)]
+    images: ImageArgs,
+}
+
+/// Image options of drawings (used only when Graphviz `dot` is on PATH; DOT files are always written).
+#[derive(Debug, Args)]
+struct ImageArgs {
+    /// Image formats rendered next to each DOT file; repeat or separate with commas.
+    #[arg(long = "image-format", value_enum, value_delimiter = ',', default_values_t = [Format::Svg, Format::Png])]
+    formats: Vec<Format>,
+    /// Resolution of PNG images in dots per inch (Graphviz' default is 96).
+    #[arg(long, value_name = "DPI")]
+    dpi: Option<u32>,
+}
+
+impl ImageArgs {
+    fn images(&self) -> Images {
+        Images {
+            formats: self.formats.iter().map(|&f| f.into()).collect(),
+            dpi: self.dpi,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Format {
+    Svg,
+    Png,
+    Pdf,
+}
+
+impl From<Format> for ImageFormat {
+    fn from(format: Format) -> Self {
+        match format {
+            Format::Svg => ImageFormat::Svg,
+            Format::Png => ImageFormat::Png,
+            Format::Pdf => ImageFormat::Pdf,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+struct CheckArgs {
+    /// Model files whose own `type` attribute says what they are.
+    #[arg(value_name = "FILE")]
+    files: Vec<PathBuf>,
+    /// Files to check as plants (needed for Nadzoru2 files, which have no type).
+    #[arg(long = "plant", value_name = "FILE", num_args = 1..)]
+    plants: Vec<PathBuf>,
+    /// Files to check as specifications.
+    #[arg(long = "spec", value_name = "FILE", num_args = 1..)]
+    specs: Vec<PathBuf>,
+    /// Keep plant probabilities (no W4; V12 applies to plants).
+    #[arg(long)]
+    thesis_literal_probabilities: bool,
+}
+
+#[derive(Debug, Args)]
+struct DrawArgs {
+    #[command(flatten)]
+    files: CheckArgs,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    #[command(flatten)]
+    images: ImageArgs,
+}
+
+#[derive(Debug, Args)]
+struct CodegenArgs {
+    #[command(flatten)]
+    project: ProjectArgs,
+    /// The Rust file to write.
+    #[arg(long, value_name = "FILE.rs")]
+    out: PathBuf,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Mode {
+    Monolithic,
+    Modular,
+    LocalModular,
+}
+
+impl From<Mode> for Architecture {
+    fn from(mode: Mode) -> Self {
+        match mode {
+            Mode::Monolithic => Architecture::Monolithic,
+            Mode::Modular => Architecture::Modular,
+            Mode::LocalModular => Architecture::LocalModular,
+        }
+    }
+}
+
+/// How a command ended when it did not fail with an I/O or usage error.
+enum Outcome {
+    Success,
+    /// Invalid input or an impossible specification (already explained on stderr).
+    Rejected,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Synth(args) => synth(&args),
+        Command::Check(args) => check(&args),
+        Command::Draw(args) => draw(&args),
+        Command::Codegen(args) => codegen(&args),
+    };
+    match result {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::Rejected) => ExitCode::from(1),
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Inputs of the files of a `check`/`draw` command.
+fn check_inputs(args: &CheckArgs) -> Vec<Input> {
+    let typed = args.files.iter().map(|p| Input::new(p, None));
+    let plants = args
+        .plants
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Plant)));
+    let specs = args
+        .specs
+        .iter()
+        .map(|p| Input::new(p, Some(ModelKind::Spec)));
+    typed.chain(plants).chain(specs).collect()
+}
+
+/// Prints every diagnostic and a count line to stderr.
+fn print_diagnostics(diagnostics: &[Diagnostic]) {
+    for d in diagnostics {
+        eprintln!("{d}");
+    }
+    let errors = diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .count();
+    let warnings = diagnostics.len() - errors;
+    if errors > 0 {
+        eprintln!("{errors} error(s), {warnings} warning(s)");
+    } else if warnings > 0 {
+        eprintln!("{warnings} warning(s)");
+    }
+}
+
+/// Loads and validates; prints diagnostics. `None` if the input is invalid.
+fn validated(inputs: &[Input], options: ValidateOptions) -> Result<Option<Vec<CheckedModel>>> {
+    if inputs.is_empty() {
+        anyhow::bail!("no model files given");
+    }
+    let validation = load(inputs, options)?;
+    print_diagnostics(&validation.diagnostics);
+    Ok(validation.models)
+}
+
+fn check(args: &CheckArgs) -> Result<Outcome> {
+    let options = ValidateOptions {
+        thesis_literal_probabilities: args.thesis_literal_probabilities,
+        ..ValidateOptions::default()
+    };
+    let inputs = check_inputs(args);
+    Ok(match validated(&inputs, options)? {
+        Some(_) => {
+            println!("{} model(s) valid", inputs.len());
+            Outcome::Success
+        }
+        None => Outcome::Rejected,
+    })
+}
+
+fn draw(args: &DrawArgs) -> Result<Outcome> {
+    let options = ValidateOptions {
+        thesis_literal_probabilities: args.files.thesis_literal_probabilities,
+        ..ValidateOptions::default()
+    };
+    let Some(models) = validated(&check_inputs(&args.files), options)? else {
+        return Ok(Outcome::Rejected);
+    };
+    let (events, automata) = to_automata(&models)?;
+    create_dir(&args.out)?;
+    let drawer = Drawer {
+        dir: &args.out,
+        events: &events,
+        images: args.images.images(),
+    };
+    let mut written = 0;
+    for a in &automata {
+        // Weights count in specifications (and in plants only with thesis-literal probabilities); supervisors
+        // already carry the probabilities the runtime uses.
+        let probs = match a.kind() {
+            ModelKind::Spec => ProbLabels::PerState,
+            ModelKind::Plant if options.thesis_literal_probabilities => ProbLabels::PerState,
+            _ => ProbLabels::Stored,
+        };
+        written += drawer.draw(&dot::file_stem(a.name()), a, &HashMap::new(), probs)?;
+    }
+    println!(
+        "{written} drawing file(s) written to {}",
+        args.out.display()
+    );
+    Ok(Outcome::Success)
+}
+
+/// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
+/// specification impossible or the result too large to compile. I/O problems are errors.
+fn built(args: &ProjectArgs) -> Result<Option<Built>> {
+    let request = BuildRequest {
+        plants: args.plants.clone(),
+        specs: args.specs.clone(),
+        architecture: args.mode.into(),
+        raw_weights: args.raw_weights,
+        thesis_literal_probabilities: args.thesis_literal_probabilities,
+    };
+    match build(&request) {
+        Ok(built) => {
+            print_diagnostics(&built.warnings);
+            Ok(Some(built))
+        }
+        Err(BuildError::Load(err)) => Err(err.into()),
+        Err(BuildError::Invalid(diagnostics)) => {
+            print_diagnostics(&diagnostics);
+            Ok(None)
+        }
+        Err(BuildError::Codegen(err)) => {
+            eprintln!("error[V15]: {err}");
+            Ok(None)
+        }
+        Err(err) => {
+            eprintln!("error: {err}");
+            Ok(None)
+        }
+    }
+}
+
+fn codegen(args: &CodegenArgs) -> Result<Outcome> {
+    let Some(Built { synthesis, set, .. }) = built(&args.project)? else {
+        return Ok(Outcome::Rejected);
+    };
+    let origin = origin(&args.project, synthesis.architecture);
+    write(&args.out, generate_rust(&set, &origin))?;
+    println!(
+        "{} supervisor(s), MemCons {} bytes: {}",
+        set.supervisors.len(),
+        set.mem_cons(),
+        args.out.display()
+    );
+    Ok(Outcome::Success)
+}
+
+fn synth(args: &SynthArgs) -> Result<Outcome> {
+    let Some(Built {
+        synthesis,
+        set,
+        warnings,
+    }) = built(&args.project)?
+    else {
+        return Ok(Outcome::Rejected);
+    };
+    let out = &args.out;
+    create_dir(out)?;
+    let events = &synthesis.normalised.events;
+    let mut files = Vec::new();
+    for s in &synthesis.supervisors {
+        let file = format!("{}.xml", dot::file_stem(&s.name));
+        write(&out.join(&file), to_xml(&s.supervisor, events))?;
+        files.push(file);
+    }
+    let bytes = set.to_bytes();
+    write(&out.join("supervisors.ptsct"), &bytes)?;
+    write(
+        &out.join("supervisors.rs"),
+        generate_rust(&set, &origin(&args.project, synthesis.architecture)),
+    )?;
+    let report = Report::new(&synthesis, &files, bytes.len(), &warnings);
+    write(
+        &out.join("report.json"),
+        report.to_json().context("cannot serialise the report")?,
+    )?;
+    if args.draw {
+        let dir = out.join("drawings");
+        create_dir(&dir)?;
+        let drawer = Drawer {
+            dir: &dir,
+            events,
+            images: args.images.images(),
+        };
+        draw_synthesis(&drawer, &synthesis)?;
+    }
+    print_summary(&synthesis, set.mem_cons(), out);
+    Ok(Outcome::Success)
+}
+
+/// A one-line description of the inputs for the generated module's header.
+fn origin(args: &ProjectArgs, architecture: Architecture) -> String {
+    let names = |paths: &[PathBuf]| {
+        paths
+            .iter()
+            .map(|p| {
+                p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned(),
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    format!(
+        "supervisor-gen synth --mode {architecture} --plant {} --spec {}",
+        names(&args.plants),
+        names(&args.specs)
+    )
+}
+
+fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
+    for s in &synthesis.supervisors {
+        println!(
+            "{}: {} states, {} transitions ({} controllable), {} events; {} state(s) of K removed",
+            s.name,
+            s.stats.states,
+            s.stats.transitions,
+            s.stats.controllable_transitions,
+            s.stats.events,
+            s.removed.len()
+        );
+    }
+    if let Some(nc) = &synthesis.non_conflict {
+        if nc.nonblocking {
+            println!("non-conflict: the supervisors are nonblocking together");
+        } else {
+            println!(
+                "warning: the supervisors conflict: {} blocking product state(s), e.g. {}",
+                nc.blocking_count,
+                nc.blocking_states.join(", ")
+            );
+        }
+    }
+    if let Some(v) = &synthesis.local_modular_validation {
+        if v.passed() {
+            println!(
+                "local-modular validation: the local supervisors equal the monolithic supervisor"
+            );
+        } else {
+            println!(
+                "warning: local-modular validation failed: see report.json (architecture_checks)"
+            );
+        }
+    }
+    println!("MemCons {mem_cons} bytes; outputs in {}", out.display());
+}
+
+/// Draws the project's inputs (once) and every stage of every supervisor.
+fn draw_synthesis(drawer: &Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
+    let project = &synthesis.normalised;
+    for a in project.plants.iter().chain(&project.specs) {
+        let stem = format!("input_{}", dot::file_stem(a.name()));
+        drawer.draw(&stem, a, &HashMap::new(), ProbLabels::Stored)?;
+    }
+    for s in synthesis
+        .supervisors
+        .iter()
+        .chain(&synthesis.monolithic_reference)
+    {
+        draw_stages(drawer, s)?;
+    }
+    Ok(())
+}
+
+/// G, E, K (with the removed states marked), SupC before minimisation, and the final supervisor.
+fn draw_stages(drawer: &Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
+    let stem = dot::file_stem(&s.name);
+    let removed: HashMap<StateId, StateMark> = s
+        .removed
+        .iter()
+        .map(|r| match r.reason {
+            RemovalReason::Bad { .. } => (r.state, StateMark::Bad),
+            _ => (r.state, StateMark::Removed),
+        })
+        .collect();
+    let none = HashMap::new();
+    let stages = [
+        ("1_G", &s.plant, &none),
+        ("2_E", &s.spec, &none),
+        ("3_K", &s.target, &removed),
+        ("4_supc", &s.unminimised, &none),
+        ("5_final", &s.supervisor, &none),
+    ];
+    for (stage, automaton, marks) in stages {
+        drawer.draw(
+            &format!("{stem}_{stage}"),
+            automaton,
+            marks,
+            ProbLabels::Stored,
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes drawings of automata over one event table into one directory.
+struct Drawer<'a> {
+    dir: &'a Path,
+    events: &'a EventTable,
+    images: Images,
+}
+
+impl Drawer<'_> {
+    /// Writes one drawing; returns the number of files written.
+    fn draw(
+        &self,
+        stem: &str,
+        a: &Automaton,
+        marks: &HashMap<StateId, StateMark>,
+        probs: ProbLabels,
+    ) -> Result<usize> {
+        let text = dot::to_dot(a, self.events, marks, probs);
+        let written = dot::write_drawing(self.dir, stem, &text, &self.images)
+            .with_context(|| format!("cannot write drawing {stem} in {}", self.dir.display()))?;
+        Ok(written.len())
+    }
+}
+
+fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
+fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("cannot write {}", path.display()))
 }

@@ -1,8 +1,10 @@
 //! Language-preserving minimisation with P and T as labels (section 7).
 //!
-//! Moore partition refinement on the accessible part, starting from {marked, unmarked}. A transition's label is
-//! the triple (event, P in Q0.16, T), so probabilities are compared by their stored encoding, never as raw floats.
-//! Signatures live in one flat buffer and classes are found by sorting, so a round allocates nothing per state.
+//! Partition refinement on the accessible part, starting from {marked, unmarked}. A transition's label is the
+//! triple (event, P in Q0.16, T), so probabilities are compared by their stored encoding, never as raw floats.
+//! The refinement is Valmari and Lehtinen's O(m log n) algorithm for partial transition functions ("Efficient
+//! minimization of DFAs with partial transition functions", STACS 2008): states and transitions live in two
+//! refinable partitions over flat arrays, so nothing is allocated per state or per round.
 //! This is not supervisor reduction (control covers): only language-equivalent states with equal labels merge.
 
 use crate::automaton::{Automaton, StateId};
@@ -18,44 +20,169 @@ pub fn minimise(a: &Automaton) -> Automaton {
     if n == 0 {
         return a;
     }
-    let mut class: Vec<u32> = (0..n).map(|x| u32::from(a.marked[x])).collect();
-    let mut classes = renumber(&mut class);
-    let mut offsets = vec![0usize; n + 1];
-    let mut sig: Vec<u64> = Vec::new();
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    loop {
-        sig.clear();
-        for x in 0..n {
-            offsets[x] = sig.len();
-            sig.push(u64::from(class[x]));
-            for t in &a.out[x] {
-                let label = (u64::from(t.event.0) << 48)
+    // Flat transition arrays: tail (source), head (target), label.
+    let m = a.transition_count();
+    let mut tail = Vec::with_capacity(m);
+    let mut head = Vec::with_capacity(m);
+    let mut label = Vec::with_capacity(m);
+    for x in a.states() {
+        for t in a.transitions(x) {
+            tail.push(x.0);
+            head.push(t.target.0);
+            label.push(
+                (u64::from(t.event.0) << 48)
                     | (u64::from(prob_to_q16(t.prob)) << 32)
-                    | u64::from(t.lower_bound);
-                sig.push(label);
-                sig.push(u64::from(class[t.target.index()]));
-            }
-        }
-        offsets[n] = sig.len();
-        let key = |x: u32| &sig[offsets[x as usize]..offsets[x as usize + 1]];
-        order.sort_unstable_by(|&x, &y| key(x).cmp(key(y)));
-        let mut next = vec![0u32; n];
-        let mut id = 0u32;
-        for (i, &x) in order.iter().enumerate() {
-            if i > 0 && key(order[i - 1]) != key(x) {
-                id += 1;
-            }
-            next[x as usize] = id;
-        }
-        let count = id as usize + 1;
-        class = next;
-        let stable = count == classes;
-        classes = renumber(&mut class);
-        if stable {
-            break;
+                    | u64::from(t.lower_bound),
+            );
         }
     }
+    // Incoming transitions of each state: in_trans[in_first[s]..in_first[s + 1]].
+    let mut in_first = vec![0usize; n + 1];
+    for &h in &head {
+        in_first[h as usize + 1] += 1;
+    }
+    for i in 0..n {
+        in_first[i + 1] += in_first[i];
+    }
+    let mut fill = in_first.clone();
+    let mut in_trans = vec![0u32; m];
+    for (t, &h) in head.iter().enumerate() {
+        in_trans[fill[h as usize]] = t as u32;
+        fill[h as usize] += 1;
+    }
+
+    let mut marks = Marks::new(n.max(m) + 1);
+    let mut blocks = Partition::new(n);
+    for x in 0..n {
+        if a.is_marked(StateId(x as u32)) {
+            blocks.mark(x, &mut marks);
+        }
+    }
+    blocks.split(&mut marks);
+    let mut cords = Partition::new(m);
+    if m > 0 {
+        cords.elems.sort_unstable_by_key(|&t| label[t as usize]);
+        cords.sets = 0;
+        let mut current = label[cords.elems[0] as usize];
+        cords.first[0] = 0;
+        for i in 0..m {
+            let t = cords.elems[i] as usize;
+            if label[t] != current {
+                current = label[t];
+                cords.past[cords.sets] = i;
+                cords.sets += 1;
+                cords.first[cords.sets] = i;
+            }
+            cords.set_of[t] = cords.sets as u32;
+            cords.loc[t] = i as u32;
+        }
+        cords.past[cords.sets] = m;
+        cords.sets += 1;
+    }
+    // Block 0 never needs to act as a splitter (Hopcroft's "all but one" argument; cords cover the rest).
+    let (mut b, mut c) = (1usize, 0usize);
+    while c < cords.sets {
+        for i in cords.first[c]..cords.past[c] {
+            blocks.mark(tail[cords.elems[i] as usize] as usize, &mut marks);
+        }
+        blocks.split(&mut marks);
+        c += 1;
+        while b < blocks.sets {
+            for i in blocks.first[b]..blocks.past[b] {
+                let s = blocks.elems[i] as usize;
+                for &t in &in_trans[in_first[s]..in_first[s + 1]] {
+                    cords.mark(t as usize, &mut marks);
+                }
+            }
+            cords.split(&mut marks);
+            b += 1;
+        }
+    }
+    let mut class: Vec<u32> = blocks.set_of.clone();
+    let classes = renumber(&mut class);
     quotient(&a, &class, classes)
+}
+
+/// Per-set mark counts and the worklist of touched sets, shared by both partitions (used one at a time).
+struct Marks {
+    count: Vec<usize>,
+    touched: Vec<usize>,
+}
+
+impl Marks {
+    fn new(capacity: usize) -> Self {
+        Self {
+            count: vec![0; capacity],
+            touched: Vec::with_capacity(capacity),
+        }
+    }
+}
+
+/// A refinable partition of `0..n`: set s holds `elems[first[s]..past[s]]`, marked elements first.
+struct Partition {
+    sets: usize,
+    elems: Vec<u32>,
+    loc: Vec<u32>,
+    set_of: Vec<u32>,
+    first: Vec<usize>,
+    past: Vec<usize>,
+}
+
+impl Partition {
+    fn new(n: usize) -> Self {
+        let mut past = vec![0; n.max(1)];
+        past[0] = n;
+        Self {
+            sets: usize::from(n > 0),
+            elems: (0..n as u32).collect(),
+            loc: (0..n as u32).collect(),
+            set_of: vec![0; n],
+            first: vec![0; n.max(1)],
+            past,
+        }
+    }
+
+    /// Marks element `e` (each element at most once between splits; a DFA guarantees this for both partitions).
+    fn mark(&mut self, e: usize, marks: &mut Marks) {
+        let s = self.set_of[e] as usize;
+        let i = self.loc[e] as usize;
+        let j = self.first[s] + marks.count[s];
+        self.elems[i] = self.elems[j];
+        self.loc[self.elems[i] as usize] = i as u32;
+        self.elems[j] = e as u32;
+        self.loc[e] = j as u32;
+        if marks.count[s] == 0 {
+            marks.touched.push(s);
+        }
+        marks.count[s] += 1;
+    }
+
+    /// Splits every touched set into its marked and unmarked parts; the smaller part becomes a new set.
+    fn split(&mut self, marks: &mut Marks) {
+        while let Some(s) = marks.touched.pop() {
+            let j = self.first[s] + marks.count[s];
+            if j == self.past[s] {
+                marks.count[s] = 0;
+                continue;
+            }
+            let z = self.sets;
+            if marks.count[s] <= self.past[s] - j {
+                self.first[z] = self.first[s];
+                self.past[z] = j;
+                self.first[s] = j;
+            } else {
+                self.past[z] = self.past[s];
+                self.first[z] = j;
+                self.past[s] = j;
+            }
+            for i in self.first[z]..self.past[z] {
+                self.set_of[self.elems[i] as usize] = z as u32;
+            }
+            marks.count[s] = 0;
+            marks.count[z] = 0;
+            self.sets += 1;
+        }
+    }
 }
 
 /// Renumbers classes densely in order of first appearance by state id (so the initial state 0's class is 0),
@@ -85,18 +212,12 @@ fn quotient(a: &Automaton, class: &[u32], classes: usize) -> Automaton {
     }
     for &x in &rep {
         let x = StateId(x);
-        r.state_names.push(a.state_name(x).to_owned());
-        r.marked.push(a.is_marked(x));
-        r.out.push(
-            a.transitions(x)
-                .iter()
-                .map(|t| {
-                    let mut t = *t;
-                    t.target = StateId(class[t.target.index()]);
-                    t
-                })
-                .collect(),
-        );
+        let merged = a.transitions(x).iter().map(|t| {
+            let mut t = *t;
+            t.target = StateId(class[t.target.index()]);
+            t
+        });
+        r.push_state(a.state_name(x), a.is_marked(x), merged);
     }
     r.initial = StateId(class[a.initial().index()]);
     r

@@ -34,7 +34,8 @@ pub struct ZeroWeights {
 /// is an input error (V12) or a post-synthesis state the runtime handles by uniform choice (5.2).
 pub fn normalise(a: &mut Automaton, events: &EventTable) -> Vec<StateId> {
     let mut zero = Vec::new();
-    for (i, list) in a.out.iter_mut().enumerate() {
+    for i in 0..a.state_count() {
+        let list = a.transitions_mut(StateId(i as u32));
         let mut sum = 0.0;
         for t in list.iter_mut() {
             if events.is_controllable(t.event) {
@@ -60,7 +61,7 @@ pub fn normalise(a: &mut Automaton, events: &EventTable) -> Vec<StateId> {
 
 /// Sets every probability of a model to 1 (plain factors, rule A5 for plants).
 pub fn set_unit_probabilities(a: &mut Automaton) {
-    for t in a.out.iter_mut().flatten() {
+    for t in a.all_transitions_mut() {
         t.prob = 1.0;
     }
 }
@@ -86,7 +87,7 @@ pub fn normalise_project(
         } else if a.kind() == ModelKind::Plant {
             set_unit_probabilities(a);
         } else {
-            for t in a.out.iter_mut().flatten() {
+            for t in a.all_transitions_mut() {
                 if !project.events.is_controllable(t.event) {
                     t.prob = 1.0;
                 }
@@ -132,7 +133,7 @@ mod tests {
     #[test]
     fn a5_plant_probabilities_are_one_unless_thesis_literal() {
         let (ev, mut a) = four_self_loops(ModelKind::Plant);
-        for t in a.out[0].iter_mut() {
+        for t in a.transitions_mut(StateId(0)) {
             t.prob = 1.0;
         }
         let p = Project {
@@ -170,7 +171,7 @@ mod tests {
     #[test]
     fn v12_all_zero_weights_are_rejected() {
         let (ev, mut a) = four_self_loops(ModelKind::Spec);
-        for t in a.out[0].iter_mut() {
+        for t in a.transitions_mut(StateId(0)) {
             t.prob = 0.0;
         }
         let p = Project {

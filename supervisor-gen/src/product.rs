@@ -1,7 +1,7 @@
 //! The n-ary synchronous product of ptSCT generators (section 4), accessible part only (C2).
 //!
-//! States are tuples of component states, stored flat and indexed by an open-addressing hash table that exists
-//! only during construction. Shared controllable events multiply P and take the maximum T; private events keep
+//! States are tuples of component states, stored flat and indexed during construction only: by direct addressing
+//! when the full tuple space is small (at most [`DENSE_LIMIT`] tuples), otherwise by an open-addressing hash table. Shared controllable events multiply P and take the maximum T; private events keep
 //! their component's labels; uncontrollable transitions carry P = 1 and T = 0. Plant factors are whatever the
 //! caller's normalisation left in them (1 under rule A5). The product of an empty list is the identity (C3).
 
@@ -73,12 +73,14 @@ pub fn product_with_tuples(
             owners[e.index()].push(c);
         }
     }
-    let mut index = TupleIndex::new(arity);
+    let sizes: Vec<usize> = parts.iter().map(|p| p.state_count()).collect();
+    let mut index = TupleIndex::new(&sizes);
     let start: Vec<u32> = parts.iter().map(|p| p.initial().0).collect();
     index.find_or_insert(&start);
     let mut cur = vec![0u32; arity];
     let mut next = vec![0u32; arity];
     let mut buf: Vec<Transition> = Vec::new();
+    let mut name = String::new();
     let mut x = 0usize;
     while x < index.len() {
         cur.copy_from_slice(index.tuple(x));
@@ -120,37 +122,23 @@ pub fn product_with_tuples(
             }
         }
         buf.sort_unstable_by_key(|t| t.event);
-        result.out.push(buf.clone());
+        name.clear();
+        if arity == 1 {
+            name.push_str(parts[0].state_name(StateId(cur[0])));
+        } else {
+            name.push('(');
+            for (i, (&q, p)) in cur.iter().zip(parts).enumerate() {
+                if i > 0 {
+                    name.push(',');
+                }
+                name.push_str(p.state_name(StateId(q)));
+            }
+            name.push(')');
+        }
+        let marked = cur.iter().zip(parts).all(|(&s, p)| p.is_marked(StateId(s)));
+        result.push_state(&name, marked, buf.iter().copied());
         x += 1;
     }
-    let n = index.len();
-    result.marked = (0..n)
-        .map(|x| {
-            index
-                .tuple(x)
-                .iter()
-                .zip(parts)
-                .all(|(&s, p)| p.is_marked(StateId(s)))
-        })
-        .collect();
-    result.state_names = (0..n)
-        .map(|x| {
-            let t = index.tuple(x);
-            if arity == 1 {
-                parts[0].state_name(StateId(t[0])).to_owned()
-            } else {
-                let mut s = String::from("(");
-                for (i, (&q, p)) in t.iter().zip(parts).enumerate() {
-                    if i > 0 {
-                        s.push(',');
-                    }
-                    s.push_str(p.state_name(StateId(q)));
-                }
-                s.push(')');
-                s
-            }
-        })
-        .collect();
     result.initial = StateId(0);
     ProductOutput {
         automaton: result,
@@ -161,19 +149,52 @@ pub fn product_with_tuples(
 
 const EMPTY: u32 = u32::MAX;
 
-/// Open-addressing map from state tuples (stored flat) to dense ids.
+/// Tuple spaces up to this size are indexed by a direct-address table (4 bytes per possible tuple).
+pub const DENSE_LIMIT: usize = 1 << 22;
+
+/// How tuples are looked up.
+enum Lookup {
+    /// `slots[Σ t_i · stride_i]` is the id of tuple t, or EMPTY.
+    Dense {
+        slots: Vec<u32>,
+        strides: Vec<usize>,
+    },
+    /// Open addressing over ids; the table length is a power of two, at most half full.
+    Hashed { table: Vec<u32> },
+}
+
+/// Map from state tuples (stored flat) to dense ids, in discovery order.
 struct TupleIndex {
     arity: usize,
     tuples: Vec<u32>,
-    table: Vec<u32>,
+    lookup: Lookup,
 }
 
 impl TupleIndex {
-    fn new(arity: usize) -> Self {
+    /// An empty index for tuples whose component i ranges over `0..sizes[i]`.
+    fn new(sizes: &[usize]) -> Self {
+        let space = sizes
+            .iter()
+            .try_fold(1usize, |acc, &n| acc.checked_mul(n.max(1)));
+        let lookup = match space {
+            Some(space) if space <= DENSE_LIMIT => {
+                let mut strides = vec![1usize; sizes.len()];
+                for i in (0..sizes.len().saturating_sub(1)).rev() {
+                    strides[i] = strides[i + 1] * sizes[i + 1].max(1);
+                }
+                Lookup::Dense {
+                    slots: vec![EMPTY; space],
+                    strides,
+                }
+            }
+            _ => Lookup::Hashed {
+                table: vec![EMPTY; 1024],
+            },
+        };
         Self {
-            arity,
+            arity: sizes.len(),
             tuples: Vec::new(),
-            table: vec![EMPTY; 1024],
+            lookup,
         }
     }
 
@@ -194,39 +215,67 @@ impl TupleIndex {
         h as usize
     }
 
+    fn equal(tuples: &[u32], arity: usize, id: u32, t: &[u32]) -> bool {
+        let base = id as usize * arity;
+        tuples[base..base + arity]
+            .iter()
+            .zip(t)
+            .all(|(a, b)| a == b)
+    }
+
     fn find_or_insert(&mut self, t: &[u32]) -> u32 {
-        let mask = self.table.len() - 1;
-        let mut slot = Self::hash(t) & mask;
-        loop {
-            let id = self.table[slot];
-            if id == EMPTY {
-                break;
-            }
-            if self.tuple(id as usize) == t {
-                return id;
-            }
-            slot = (slot + 1) & mask;
-        }
         let id = self.len() as u32;
+        match &mut self.lookup {
+            Lookup::Dense { slots, strides } => {
+                let key: usize = t
+                    .iter()
+                    .zip(strides.iter())
+                    .map(|(&v, &s)| v as usize * s)
+                    .sum();
+                if slots[key] != EMPTY {
+                    return slots[key];
+                }
+                slots[key] = id;
+            }
+            Lookup::Hashed { table } => {
+                let mask = table.len() - 1;
+                let mut slot = Self::hash(t) & mask;
+                loop {
+                    let found = table[slot];
+                    if found == EMPTY {
+                        break;
+                    }
+                    if Self::equal(&self.tuples, self.arity, found, t) {
+                        return found;
+                    }
+                    slot = (slot + 1) & mask;
+                }
+                table[slot] = id;
+            }
+        }
         self.tuples.extend_from_slice(t);
-        self.table[slot] = id;
-        if self.len() * 2 > self.table.len() {
+        if let Lookup::Hashed { table } = &self.lookup
+            && self.len() * 2 > table.len()
+        {
             self.grow();
         }
         id
     }
 
     fn grow(&mut self) {
-        let mut table = vec![EMPTY; self.table.len() * 2];
-        let mask = table.len() - 1;
-        for x in 0..self.len() {
-            let mut slot = Self::hash(self.tuple(x)) & mask;
-            while table[slot] != EMPTY {
-                slot = (slot + 1) & mask;
+        if let Lookup::Hashed { table } = &mut self.lookup {
+            let mut bigger = vec![EMPTY; table.len() * 2];
+            let mask = bigger.len() - 1;
+            for x in 0..self.tuples.len() / self.arity {
+                let mut slot =
+                    Self::hash(&self.tuples[x * self.arity..(x + 1) * self.arity]) & mask;
+                while bigger[slot] != EMPTY {
+                    slot = (slot + 1) & mask;
+                }
+                bigger[slot] = x as u32;
             }
-            table[slot] = x as u32;
+            *table = bigger;
         }
-        self.table = table;
     }
 }
 
@@ -294,14 +343,19 @@ mod tests {
     }
 
     #[test]
-    fn tuple_index_survives_growth() {
-        let mut idx = TupleIndex::new(2);
-        for i in 0..5000u32 {
-            assert_eq!(idx.find_or_insert(&[i, i ^ 7]), i);
+    fn hashed_and_dense_tuple_indexes_agree() {
+        // 5000 x 5000 exceeds DENSE_LIMIT (hashed, growing); 100 x 100 does not (dense).
+        for n in [5000u32, 100] {
+            let mut idx = TupleIndex::new(&[n as usize, n as usize]);
+            assert_eq!(matches!(idx.lookup, Lookup::Dense { .. }), n == 100);
+            for i in 0..n {
+                assert_eq!(idx.find_or_insert(&[i, (i * 7 + 3) % n]), i);
+            }
+            for i in 0..n {
+                assert_eq!(idx.find_or_insert(&[i, (i * 7 + 3) % n]), i);
+                assert_eq!(idx.tuple(i as usize), &[i, (i * 7 + 3) % n]);
+            }
+            assert_eq!(idx.len(), n as usize);
         }
-        for i in 0..5000u32 {
-            assert_eq!(idx.find_or_insert(&[i, i ^ 7]), i);
-        }
-        assert_eq!(idx.len(), 5000);
     }
 }

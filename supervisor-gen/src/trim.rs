@@ -19,8 +19,10 @@ impl ReverseAdjacency {
     pub fn new(a: &Automaton) -> Self {
         let n = a.state_count();
         let mut offsets = vec![0u32; n + 1];
-        for t in a.out.iter().flatten() {
-            offsets[t.target.index() + 1] += 1;
+        for x in a.states() {
+            for t in a.transitions(x) {
+                offsets[t.target.index() + 1] += 1;
+            }
         }
         for i in 0..n {
             offsets[i + 1] += offsets[i];
@@ -29,10 +31,10 @@ impl ReverseAdjacency {
         let mut fill = offsets.clone();
         let mut sources = vec![0u32; m];
         let mut events = vec![EventId(0); m];
-        for (x, list) in a.out.iter().enumerate() {
-            for t in list {
+        for x in a.states() {
+            for t in a.transitions(x) {
                 let slot = &mut fill[t.target.index()];
-                sources[*slot as usize] = x as u32;
+                sources[*slot as usize] = x.0;
                 events[*slot as usize] = t.event;
                 *slot += 1;
             }
@@ -116,19 +118,16 @@ pub fn restrict(a: &Automaton, keep: &[bool]) -> (Automaton, Vec<StateId>) {
         old_of.push(x);
     }
     for &x in &old_of {
-        r.state_names.push(a.state_name(x).to_owned());
-        r.marked.push(a.is_marked(x));
-        r.out.push(
-            a.transitions(x)
-                .iter()
-                .filter(|t| keep[t.target.index()])
-                .map(|t| {
-                    let mut t = *t;
-                    t.target = StateId(new_id[t.target.index()]);
-                    t
-                })
-                .collect(),
-        );
+        let kept = a
+            .transitions(x)
+            .iter()
+            .filter(|t| keep[t.target.index()])
+            .map(|t| {
+                let mut t = *t;
+                t.target = StateId(new_id[t.target.index()]);
+                t
+            });
+        r.push_state(a.state_name(x), a.is_marked(x), kept);
     }
     r.initial = StateId(new_id[a.initial().index()]);
     (r, old_of)

@@ -1,0 +1,151 @@
+//! Choosing a robot's controller from a parsed experiment, with errors located in the `.argos` file.
+//!
+//! A robot's controller is the one its `<e-puck>` names, found by the robot's index in the canonical order
+//! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes become the [`Params`] of its profile or native
+//! controller, and relative paths in them resolve against the configuration's folder.
+
+use swarm_runtime::config::{Controller, Diagnostic, Experiment, Location};
+
+use crate::control::{self, Control};
+use crate::controller::{self, Plan};
+use crate::params::Params;
+
+/// The controller of robot `robot` (its index in the canonical robot order, `Arena::robots`).
+pub fn controller_of(experiment: &Experiment, robot: u32) -> Result<&Controller, Diagnostic> {
+    let file_level = Location { line: 0, column: 0 };
+    let robots = experiment.arena.robots();
+    let Some(entry) = robots.iter().find(|r| r.index == robot) else {
+        return Err(experiment.diagnostic(
+            file_level,
+            format!(
+                "there is no robot {robot}: the configuration has {} robots",
+                robots.len()
+            ),
+        ));
+    };
+    experiment
+        .controller(&entry.epuck.controller)
+        .ok_or_else(|| {
+            experiment.diagnostic(
+                entry.epuck.location,
+                format!(
+                    "robot {robot} (`{}`) names controller `{}`, which is not declared",
+                    entry.id, entry.epuck.controller
+                ),
+            )
+        })
+}
+
+/// The `<params>` attributes of `controller`.
+pub fn params_of(controller: &Controller) -> Params {
+    Params::new(
+        controller
+            .params
+            .attributes
+            .iter()
+            .map(|(name, attribute)| (name.clone(), attribute.value.clone())),
+    )
+}
+
+/// Plans and builds `controller` of `experiment` for robot `robot` of a run seeded with `run_seed`; any failure
+/// is located at the controller's `<params>` element.
+pub fn build(
+    experiment: &Experiment,
+    controller: &Controller,
+    run_seed: u64,
+    robot: u32,
+) -> Result<(Plan, Control), Diagnostic> {
+    let params = params_of(controller);
+    let located = |message: String| {
+        experiment.diagnostic(
+            controller.params.location,
+            format!(
+                "controller `{}` (<{}>): {message}",
+                controller.id, controller.tag
+            ),
+        )
+    };
+    let plan = controller::plan(&controller.tag, &params, experiment.base_dir())
+        .map_err(|e| located(e.to_string()))?;
+    let control =
+        control::build(&plan, &params, run_seed, robot).map_err(|e| located(e.to_string()))?;
+    Ok((plan, control))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TWO: &str = r#"<?xml version="1.0" ?>
+<argos-configuration>
+  <framework>
+    <experiment length="1" ticks_per_second="20" random_seed="1" />
+  </framework>
+  <controllers>
+    <epuck_obstacle_avoidance_sct_prob_controller id="fdc" library="robot-agent">
+      <actuators><epuck_wheels implementation="default" /></actuators>
+      <sensors><epuck_proximity implementation="default" /></sensors>
+      <params velocity="12.8" />
+    </epuck_obstacle_avoidance_sct_prob_controller>
+    <epuck_obstacle_avoidance_sct_prob_controller id="bad" library="robot-agent">
+      <actuators><epuck_wheels implementation="default" /></actuators>
+      <sensors><epuck_proximity implementation="default" /></sensors>
+      <params theta_obs="2" />
+    </epuck_obstacle_avoidance_sct_prob_controller>
+  </controllers>
+  <arena size="1,1,1" center="0,0,0.5">
+    <e-puck id="r0"><body position="0,0,0" orientation="0,0,0" /><controller config="fdc" /></e-puck>
+    <e-puck id="r1"><body position="0.2,0,0" orientation="0,0,0" /><controller config="bad" /></e-puck>
+  </arena>
+  <physics_engines><dynamics2d id="dyn2d" /></physics_engines>
+  <media />
+</argos-configuration>
+"#;
+
+    fn experiment() -> Experiment {
+        match Experiment::parse("/cfg/two.argos", TWO) {
+            Ok((experiment, _warnings)) => experiment,
+            Err(errors) => panic!("{errors}"),
+        }
+    }
+
+    #[test]
+    fn robot_index_selects_its_controller() {
+        let e = experiment();
+        assert_eq!(controller_of(&e, 0).unwrap().id, "fdc");
+        assert_eq!(controller_of(&e, 1).unwrap().id, "bad");
+    }
+
+    #[test]
+    fn robot_beyond_the_configuration_is_rejected() {
+        let e = experiment();
+        assert_eq!(
+            controller_of(&e, 2).unwrap_err().to_string(),
+            "/cfg/two.argos: there is no robot 2: the configuration has 2 robots"
+        );
+    }
+
+    #[test]
+    fn thesis_controller_builds_from_the_config() {
+        let e = experiment();
+        let (plan, _) = build(&e, controller_of(&e, 0).unwrap(), 1, 0).unwrap();
+        assert_eq!(
+            plan.to_string(),
+            "profile `obstacle_avoidance` with supervisors built-in obstacle_avoidance/ptsct"
+        );
+    }
+
+    #[test]
+    fn bad_param_is_located_at_the_params_element() {
+        let e = experiment();
+        let err = build(&e, controller_of(&e, 1).unwrap(), 1, 0)
+            .err()
+            .unwrap()
+            .to_string();
+        assert_eq!(
+            err,
+            "/cfg/two.argos:15:7: controller `bad` (<epuck_obstacle_avoidance_sct_prob_controller>): profile \
+             `obstacle_avoidance`: parameter `theta_obs` = 2 is out of range: must be in [0, 1]"
+        );
+    }
+}

@@ -1,0 +1,75 @@
+//! Native controllers: hand-written control steps that need no supervisors, registered under the names configs
+//! use for them.
+
+pub mod epuck_obstacleavoidance;
+
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use thiserror::Error;
+
+use crate::params::{ParamError, Params};
+use epuck_obstacleavoidance::EpuckObstacleAvoidance;
+
+/// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
+pub trait NativeController: Send {
+    /// One control step. Must not allocate.
+    fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand);
+}
+
+/// A native controller ready to run.
+pub type BoxedNative = Box<dyn NativeController>;
+
+type BuildFn = fn(&Params) -> Result<BoxedNative, ParamError>;
+
+/// Every native controller, by name.
+const NATIVE: &[(&str, BuildFn)] = &[(EpuckObstacleAvoidance::NAME, |p| {
+    Ok(Box::new(EpuckObstacleAvoidance::from_params(p)?))
+})];
+
+/// Why a native controller could not be built.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NativeError {
+    /// No native controller has this name.
+    #[error("unknown native controller `{name}` (known: {known})")]
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// Comma-separated registered names.
+        known: String,
+    },
+    /// A parameter is bad.
+    #[error("native controller `{name}`: {problem}")]
+    Param {
+        /// The controller.
+        name: String,
+        /// The parameter problem.
+        problem: ParamError,
+    },
+}
+
+/// Names of all registered native controllers.
+pub fn native_names() -> impl Iterator<Item = &'static str> {
+    NATIVE.iter().map(|(name, _)| *name)
+}
+
+/// Whether a native controller of this name is registered.
+pub fn is_native(name: &str) -> bool {
+    NATIVE.iter().any(|(n, _)| *n == name)
+}
+
+/// Builds native controller `name` from `params`.
+pub fn build_native(name: &str, params: &Params) -> Result<BoxedNative, NativeError> {
+    let Some((_, build)) = NATIVE.iter().find(|(n, _)| *n == name) else {
+        return Err(NativeError::Unknown {
+            name: name.to_owned(),
+            known: NATIVE
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    };
+    build(params).map_err(|problem| NativeError::Param {
+        name: name.to_owned(),
+        problem,
+    })
+}

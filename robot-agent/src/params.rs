@@ -1,0 +1,166 @@
+//! Controller parameters: the attributes of a controller's `<params>` element, read with typed getters.
+//!
+//! Profiles and native controllers read their numbers (speeds in cm/s, thresholds) from here once at startup;
+//! nothing here runs per tick. Errors name the parameter and the offending value; the caller adds the file and
+//! line of the `<params>` element.
+
+use thiserror::Error;
+
+/// A bad controller parameter.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ParamError {
+    /// The value does not parse as the expected type.
+    #[error("parameter `{name}` = \"{value}\" is not {expected}")]
+    Malformed {
+        /// Parameter name.
+        name: String,
+        /// Value as written.
+        value: String,
+        /// What was expected, e.g. "a finite number".
+        expected: &'static str,
+    },
+    /// The value parses but lies outside the allowed range.
+    #[error("parameter `{name}` = {value} is out of range: {rule}")]
+    OutOfRange {
+        /// Parameter name.
+        name: String,
+        /// Value as written.
+        value: String,
+        /// The rule it breaks, e.g. "must be >= 0".
+        rule: &'static str,
+    },
+}
+
+/// The attributes of a `<params>` element, in document order.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Params {
+    entries: Vec<(String, String)>,
+}
+
+impl Params {
+    /// Parameters from name/value pairs (later duplicates win, as in an XML attribute map).
+    pub fn new<I, K, V>(pairs: I) -> Self
+    where
+        I: IntoIterator<Item = (K, V)>,
+        K: Into<String>,
+        V: Into<String>,
+    {
+        Self {
+            entries: pairs
+                .into_iter()
+                .map(|(k, v)| (k.into(), v.into()))
+                .collect(),
+        }
+    }
+
+    /// The raw value of `name`, if given.
+    pub fn get(&self, name: &str) -> Option<&str> {
+        self.entries
+            .iter()
+            .rev()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// All parameters, in document order.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.entries.iter().map(|(k, v)| (k.as_str(), v.as_str()))
+    }
+
+    /// `name` as a finite `f32`, or `default` when absent.
+    pub fn f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+        let Some(raw) = self.get(name) else {
+            return Ok(default);
+        };
+        match raw.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(ParamError::Malformed {
+                name: name.to_owned(),
+                value: raw.to_owned(),
+                expected: "a finite number",
+            }),
+        }
+    }
+
+    /// `name` as a finite `f32` >= 0 (a speed), or `default` when absent.
+    pub fn non_negative_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+        let v = self.f32_or(name, default)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(ParamError::OutOfRange {
+                name: name.to_owned(),
+                value: self.get(name).unwrap_or_default().to_owned(),
+                rule: "must be >= 0",
+            })
+        }
+    }
+
+    /// `name` as a finite `f32` in `[0, 1]` (a sensor reading), or `default` when absent.
+    pub fn unit_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+        let v = self.f32_or(name, default)?;
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err(ParamError::OutOfRange {
+                name: name.to_owned(),
+                value: self.get(name).unwrap_or_default().to_owned(),
+                rule: "must be in [0, 1]",
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn absent_parameter_takes_the_default() {
+        assert_eq!(Params::default().f32_or("velocity", 12.8), Ok(12.8));
+    }
+
+    #[test]
+    fn velocity_parses_as_written_in_the_thesis_config() {
+        let p = Params::new([("velocity", "12.8")]);
+        assert_eq!(p.non_negative_f32_or("velocity", 1.0), Ok(12.8));
+    }
+
+    #[test]
+    fn non_numeric_value_names_parameter_and_value() {
+        let p = Params::new([("velocity", "fast")]);
+        let err = p.f32_or("velocity", 12.8).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "parameter `velocity` = \"fast\" is not a finite number"
+        );
+    }
+
+    #[test]
+    fn negative_velocity_is_rejected() {
+        let p = Params::new([("velocity", "-3")]);
+        let err = p.non_negative_f32_or("velocity", 12.8).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "parameter `velocity` = -3 is out of range: must be >= 0"
+        );
+    }
+
+    #[test]
+    fn threshold_above_one_is_rejected() {
+        let p = Params::new([("theta_obs", "1.5")]);
+        assert!(matches!(
+            p.unit_f32_or("theta_obs", 0.1),
+            Err(ParamError::OutOfRange { .. })
+        ));
+    }
+
+    #[test]
+    fn infinite_value_is_malformed() {
+        let p = Params::new([("velocity", "inf")]);
+        assert!(matches!(
+            p.f32_or("velocity", 12.8),
+            Err(ParamError::Malformed { .. })
+        ));
+    }
+}

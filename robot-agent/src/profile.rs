@@ -1,0 +1,44 @@
+//! What an operational-procedure profile is (ptsct.md 8.1, layer 3): per-robot memory plus one callback per event.
+//!
+//! A profile is a type holding one robot's memory and parameters; its [`Profile::PROCEDURES`] table maps the event
+//! names the models use to plain function pointers. Controllable events get an action on the
+//! [`ActuatorCommand`]; uncontrollable events get a pure check of the [`SensorFrame`] (ptsct.md 8.2). A profile
+//! never sees the world or the supervisors: only the frame of the current tick and its own memory.
+
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+
+use crate::params::{ParamError, Params};
+
+/// The operational procedure of one event.
+pub enum Procedure<S> {
+    /// Check of an uncontrollable event: whether it occurred in this tick's frame. Level-triggered and pure.
+    Check(fn(&S, &SensorFrame) -> bool),
+    /// Action of a controllable event: runs after the supervisors moved and may update the robot's memory.
+    Act(fn(&mut S, &SensorFrame, &mut ActuatorCommand)),
+}
+
+impl<S> Clone for Procedure<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S> Copy for Procedure<S> {}
+
+impl<S> Procedure<S> {
+    /// Whether this procedure serves a controllable event (an action) rather than an uncontrollable one (a check).
+    pub fn is_action(&self) -> bool {
+        matches!(self, Procedure::Act(_))
+    }
+}
+
+/// A profile: one robot's memory, built from the controller's `<params>`, plus its callback table.
+pub trait Profile: Sized + Send + 'static {
+    /// The name configs use for this profile (`<params profile="...">`); the registry key.
+    const NAME: &'static str;
+    /// Event name -> procedure, one entry per event the profile serves.
+    const PROCEDURES: &'static [(&'static str, Procedure<Self>)];
+
+    /// A fresh robot memory with parameters read from `params`.
+    fn from_params(params: &Params) -> Result<Self, ParamError>;
+}

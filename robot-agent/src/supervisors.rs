@@ -1,0 +1,249 @@
+//! Where a robot's supervisor set comes from: a compiled file, a folder of XML models synthesised at startup, or
+//! the models built into this binary.
+//!
+//! Models go through supervisor-gen's library exactly as `supervisor-gen synth` would take them: read, validate
+//! (every located diagnostic reported at once), local-modular synthesis, minimisation, compilation. This module
+//! runs only at startup; it never touches the tick loop.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use supervisor_gen::architecture::Architecture;
+use supervisor_gen::compiled::{CodegenError, CompiledFormatError, SupervisorSet};
+use supervisor_gen::convert::{ConvertError, to_project};
+use supervisor_gen::diagnostics::{Diagnostic, has_errors};
+use supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
+use supervisor_gen::validate::{ValidateOptions, validate};
+use supervisor_gen::xml_read::read_model;
+use thiserror::Error;
+use tracing::warn;
+
+/// One model file: the name diagnostics use, and its text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ModelText<'a> {
+    /// File name as shown in diagnostics.
+    pub file: &'a str,
+    /// XML text.
+    pub text: &'a str,
+}
+
+/// The ptSCT obstacle-avoidance models (configs/obstacle_avoidance/models/ptsct), built into the binary for the
+/// thesis' `epuck_obstacle_avoidance_sct_prob_controller`.
+pub const OBSTACLE_AVOIDANCE_PTSCT: &[ModelText<'static>] = &[
+    ModelText {
+        file: "builtin:obstacle_avoidance/ptsct/G_prox.xml",
+        text: include_str!("../../configs/obstacle_avoidance/models/ptsct/G_prox.xml"),
+    },
+    ModelText {
+        file: "builtin:obstacle_avoidance/ptsct/G_motor.xml",
+        text: include_str!("../../configs/obstacle_avoidance/models/ptsct/G_motor.xml"),
+    },
+    ModelText {
+        file: "builtin:obstacle_avoidance/ptsct/E_walk.xml",
+        text: include_str!("../../configs/obstacle_avoidance/models/ptsct/E_walk.xml"),
+    },
+    ModelText {
+        file: "builtin:obstacle_avoidance/ptsct/E_avoid.xml",
+        text: include_str!("../../configs/obstacle_avoidance/models/ptsct/E_avoid.xml"),
+    },
+];
+
+/// The located diagnostics of models that failed validation, one per line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostics(pub Vec<Diagnostic>);
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{d}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Why no supervisor set could be loaded.
+#[derive(Debug, Error)]
+pub enum SupervisorError {
+    /// A model file or folder could not be read.
+    #[error("cannot read {}: {problem}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The OS error.
+        problem: std::io::Error,
+    },
+    /// No supervisor file was named.
+    #[error("no supervisor files given")]
+    NoFiles,
+    /// XML models and compiled files were mixed.
+    #[error(
+        "give either XML model files (or one folder of them) or one compiled supervisor file, not a mix"
+    )]
+    Mixed,
+    /// A folder of models holds no `.xml` file.
+    #[error("{}: no .xml model files in this folder", path.display())]
+    NoModels {
+        /// The folder.
+        path: PathBuf,
+    },
+    /// The models have errors.
+    #[error("the supervisor models have errors:\n{0}")]
+    Invalid(Diagnostics),
+    /// Validated models could not become a project.
+    #[error(transparent)]
+    Convert(#[from] ConvertError),
+    /// Synthesis found no supervisor.
+    #[error(transparent)]
+    Synthesis(#[from] SynthesisError),
+    /// The supervisors exceed the compiled layout's limits.
+    #[error(transparent)]
+    Codegen(#[from] CodegenError),
+    /// A compiled supervisor file is unreadable or malformed.
+    #[error(transparent)]
+    Compiled(#[from] CompiledFormatError),
+}
+
+/// Loads a supervisor set from `files`: XML model files, or one folder of them (synthesised local-modular), or
+/// one compiled supervisor-set file.
+pub fn load(files: &[PathBuf]) -> Result<SupervisorSet, SupervisorError> {
+    let is_xml = |p: &Path| p.extension().is_some_and(|x| x == "xml");
+    let models: Vec<PathBuf> = match files {
+        [] => return Err(SupervisorError::NoFiles),
+        [one] if one.is_dir() => models_in(one)?,
+        [one] if !is_xml(one) => return Ok(SupervisorSet::read(one)?),
+        many if many.iter().all(|p| is_xml(p)) => many.to_vec(),
+        _ => return Err(SupervisorError::Mixed),
+    };
+    let mut texts = Vec::with_capacity(models.len());
+    for file in &models {
+        let text = std::fs::read_to_string(file).map_err(|problem| SupervisorError::Io {
+            path: file.clone(),
+            problem,
+        })?;
+        texts.push((file.display().to_string(), text));
+    }
+    let models: Vec<ModelText<'_>> = texts
+        .iter()
+        .map(|(file, text)| ModelText { file, text })
+        .collect();
+    synthesise(&models)
+}
+
+/// The `.xml` files of folder `dir`, sorted by name.
+fn models_in(dir: &Path) -> Result<Vec<PathBuf>, SupervisorError> {
+    let io = |problem| SupervisorError::Io {
+        path: dir.to_owned(),
+        problem,
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .map(|entry| entry.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .map_err(io)?;
+    files.retain(|p| p.extension().is_some_and(|x| x == "xml"));
+    files.sort();
+    if files.is_empty() {
+        return Err(SupervisorError::NoModels {
+            path: dir.to_owned(),
+        });
+    }
+    Ok(files)
+}
+
+/// Validates `models` and synthesises their local-modular supervisor set.
+pub fn synthesise(models: &[ModelText<'_>]) -> Result<SupervisorSet, SupervisorError> {
+    let mut problems = Vec::new();
+    let mut sources = Vec::with_capacity(models.len());
+    for m in models {
+        match read_model(m.file, m.text, None) {
+            Ok(source) => sources.push(source),
+            Err(mut found) => problems.append(&mut found),
+        }
+    }
+    let validation = validate(&sources, ValidateOptions::default());
+    problems.extend(validation.diagnostics);
+    let checked = match validation.models {
+        Some(checked) if !has_errors(&problems) => checked,
+        _ => {
+            problems.retain(Diagnostic::is_error);
+            return Err(SupervisorError::Invalid(Diagnostics(problems)));
+        }
+    };
+    for w in &problems {
+        warn!("{w}");
+    }
+    let project = to_project(&checked)?;
+    let options = SynthesisOptions {
+        validate: false,
+        ..SynthesisOptions::default()
+    };
+    let synthesis = synthesize(&project, Architecture::LocalModular, options)?;
+    Ok(synthesis.compile()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_obstacle_avoidance_models_give_two_local_supervisors() {
+        let set = synthesise(OBSTACLE_AVOIDANCE_PTSCT).unwrap();
+        assert_eq!(set.supervisors.len(), 2);
+        let mut names: Vec<(&str, bool)> = set
+            .events
+            .iter()
+            .map(|e| (e.name.as_str(), e.controllable))
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                ("Go", true),
+                ("saw-obs", false),
+                ("turn-inv-obs", true),
+                ("turn-left", true),
+                ("turn-right", true),
+            ]
+        );
+    }
+
+    #[test]
+    fn invalid_model_reports_file_line_and_column() {
+        let broken = ModelText {
+            file: "E_bad.xml",
+            text: "<automata name=\"E_bad\" type=\"spec\">\n  <states><state name=\"a\" i=\"1\" m=\"1\"/></states>\n  \
+                   <events><event name=\"x\" con=\"1\"/></events>\n  \
+                   <transitions><transition src=\"a\" dst=\"nowhere\" event=\"x\"/></transitions>\n</automata>\n",
+        };
+        let err = synthesise(&[broken]).unwrap_err().to_string();
+        assert!(
+            err.starts_with("the supervisor models have errors:\nE_bad.xml:4:"),
+            "{err}"
+        );
+        assert!(err.contains("nowhere"), "{err}");
+    }
+
+    #[test]
+    fn xml_models_and_a_compiled_file_cannot_be_mixed() {
+        let files = [PathBuf::from("G.xml"), PathBuf::from("set.sup")];
+        assert!(matches!(load(&files), Err(SupervisorError::Mixed)));
+    }
+
+    #[test]
+    fn folder_without_models_is_rejected() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = load(&[dir.path().to_owned()]).unwrap_err();
+        assert!(matches!(err, SupervisorError::NoModels { .. }));
+    }
+
+    #[test]
+    fn missing_compiled_file_names_the_path() {
+        let err = load(&[PathBuf::from("/nonexistent/oa.sup")])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("/nonexistent/oa.sup"), "{err}");
+    }
+}
