@@ -56,6 +56,16 @@ pub enum BuildError {
 }
 
 impl Control {
+    /// Names of the events the controller's supervisors fire, by event id (empty for a native controller).
+    pub fn event_names(&self) -> Vec<String> {
+        match self {
+            Control::Supervised { player, .. } => {
+                player.events().iter().map(|e| e.name.clone()).collect()
+            }
+            Control::Native(_) => Vec::new(),
+        }
+    }
+
     /// One control step: the player's step with the bound callbacks, or the native controller's step. `command`
     /// carries the actuator state over from the previous tick; allocates nothing.
     pub fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {

@@ -50,7 +50,11 @@ struct Args {
     /// Without --config: controller parameter, as an attribute of <params> (repeatable), e.g. --param velocity=5.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     params: Vec<(String, String)>,
-    /// Load, synthesise and bind the controller, then exit without joining the run.
+    /// Number of robots of the run, when `swarm run --robots` changed the configuration's count (with --config).
+    #[arg(long, requires = "config")]
+    robots: Option<u32>,
+    /// Load, synthesise and bind the controller, print its event names by id as a JSON array on standard output,
+    /// then exit without joining the run.
     #[arg(long)]
     check: bool,
 }
@@ -67,6 +71,12 @@ fn build_control(args: &Args) -> Result<Control> {
     if let Some(path) = &args.config {
         let (experiment, warnings) =
             Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
+        let experiment = match args.robots {
+            Some(robots) => experiment
+                .with_robot_count(robots)
+                .map_err(|errors| anyhow!("{errors}"))?,
+            None => experiment,
+        };
         for w in &warnings {
             debug!("{w}");
         }
@@ -123,6 +133,7 @@ fn run(args: &Args) -> Result<()> {
         .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
     let Some(root) = args.root.as_deref().filter(|_| !args.check) else {
         info!(robot = args.robot, "controller checked");
+        println!("{}", serde_json::to_string(&control.event_names())?);
         return Ok(());
     };
     serve(args, root, &mut control)

@@ -17,7 +17,14 @@ pub fn bin_dir() -> &'static Path {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let status = Command::new(cargo)
             .args(["build", "--quiet", "--bins"])
-            .args(["-p", "swarm-runtime", "-p", "swarm-world", "-p", "robot-agent"])
+            .args([
+                "-p",
+                "swarm-runtime",
+                "-p",
+                "swarm-world",
+                "-p",
+                "robot-agent",
+            ])
             .current_dir(workspace_root())
             .status()
             .expect("cargo must be runnable from the tests");
@@ -121,6 +128,14 @@ pub fn process_leftovers(run_prefix: &str) -> Vec<u32> {
 /// Asserts that the runs of `outcome` left no process and no shared-memory file.
 pub fn assert_clean(outcome: &SwarmOutcome) {
     let prefix = outcome.run_prefix();
-    assert_eq!(process_leftovers(&prefix), Vec::<u32>::new(), "processes outlived the run");
-    assert_eq!(shm_leftovers(&prefix), Vec::<PathBuf>::new(), "shared memory outlived the run");
+    assert_eq!(
+        process_leftovers(&prefix),
+        Vec::<u32>::new(),
+        "processes outlived the run"
+    );
+    assert_eq!(
+        shm_leftovers(&prefix),
+        Vec::<PathBuf>::new(),
+        "shared memory outlived the run"
+    );
 }

@@ -92,12 +92,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;
-            let ticking = (report.wall_seconds - report.time_to_first_tick_seconds).max(f64::EPSILON);
+            let ticking =
+                (report.wall_seconds - report.time_to_first_tick_seconds).max(f64::EPSILON);
             let steps = f64::from(report.robots) * report.ticks as f64;
             println!(
                 "{} after {} ticks: {} robots, seed {}, {:.1} s ({:.2} s to the first tick), {:.0} robot-steps/s, \
                  {} deaths; records in {}",
-                if report.interrupted { "stopped" } else { "finished" },
+                if report.interrupted {
+                    "stopped"
+                } else {
+                    "finished"
+                },
                 report.ticks,
                 report.robots,
                 report.seed,

@@ -28,7 +28,9 @@ impl Experiment {
                 return Err(error(
                     &self,
                     self.arena.location,
-                    format!("cannot run {robots} robots: the arena has no e-puck <distribute> whose quantity could change"),
+                    format!(
+                        "cannot run {robots} robots: the arena has no e-puck <distribute> whose quantity could change"
+                    ),
                 ));
             }
             [_, second, ..] => {
@@ -93,12 +95,19 @@ mod tests {
     }
 
     fn ids(experiment: &Experiment) -> Vec<String> {
-        experiment.arena.robots().into_iter().map(|r| r.id).collect()
+        experiment
+            .arena
+            .robots()
+            .into_iter()
+            .map(|r| r.id)
+            .collect()
     }
 
     #[test]
     fn robot_count_resizes_the_epuck_distribution_around_hand_placed_robots() {
-        let resized = experiment().with_robot_count(6).unwrap_or_else(|e| panic!("{e}"));
+        let resized = experiment()
+            .with_robot_count(6)
+            .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(ids(&resized), ["lead", "fb5", "fb6", "fb7", "fb8", "fb9"]);
     }
 

@@ -100,7 +100,15 @@ fn build_with_cargo(cargo: &str, dir: &Path) -> Result<(), BinariesError> {
         return Ok(());
     }
     let mut command = Command::new(cargo);
-    command.args(["build", "--quiet", "-p", "swarm-world", "-p", "robot-agent", "--bins"]);
+    command.args([
+        "build",
+        "--quiet",
+        "-p",
+        "swarm-world",
+        "-p",
+        "robot-agent",
+        "--bins",
+    ]);
     match profile {
         "debug" => {}
         "release" => {

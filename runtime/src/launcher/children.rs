@@ -61,10 +61,20 @@ impl Children {
 
     /// Kills and reaps every child still running.
     pub fn kill_all(&mut self) {
-        for child in self.agents.iter_mut().flatten().chain(self.world.iter_mut()) {
+        for child in self
+            .agents
+            .iter_mut()
+            .flatten()
+            .chain(self.world.iter_mut())
+        {
             signal(child, Signal::SIGKILL);
         }
-        for child in self.agents.iter_mut().flatten().chain(self.world.iter_mut()) {
+        for child in self
+            .agents
+            .iter_mut()
+            .flatten()
+            .chain(self.world.iter_mut())
+        {
             let _ = child.wait();
         }
         self.agents.clear();

@@ -181,7 +181,10 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .or(experiment.framework.random_seed)
         .unwrap_or_else(clock_seed);
     if options.seed.is_none() && experiment.framework.random_seed.is_none() {
-        tracing::warn!(seed, "no random_seed in the configuration: using one from the clock");
+        tracing::warn!(
+            seed,
+            "no random_seed in the configuration: using one from the clock"
+        );
     }
     let ticks = options
         .ticks
@@ -198,6 +201,16 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     };
     let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
     tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
+
+    check_controllers(
+        &binaries,
+        &run_args,
+        &config,
+        seed,
+        options.robots,
+        &roster,
+        &out_dir,
+    )?;
 
     let started = Instant::now();
     let mut children = Children::default();
@@ -233,7 +246,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             robots: options.robots,
         };
         let log_path = run_dir::agent_log(&out_dir, robot as u32);
-        let log = std::fs::File::create(&log_path).map_err(io(format!("creating {}", log_path.display())))?;
+        let log = std::fs::File::create(&log_path)
+            .map_err(io(format!("creating {}", log_path.display())))?;
         let child = children::spawn(
             Command::new(&binaries.agent)
                 .args(agent_args.to_args())
@@ -276,6 +290,58 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     };
     complete_summary(&out_dir, &report)?;
     Ok(report)
+}
+
+/// File in the run directory with each controller's event names by id, for the world's `events.csv`.
+pub const EVENT_TABLES_FILE: &str = "event_tables.json";
+
+/// Builds every controller of the run once, before any process of the run starts (`robot-agent --check` for the
+/// first robot of each controller), so a missing callback or a bad supervisor file fails the run at once with the
+/// agent's reason; records each controller's event names in [`EVENT_TABLES_FILE`].
+fn check_controllers(
+    binaries: &Binaries,
+    run_args: &RunArgs,
+    config: &Path,
+    seed: u64,
+    robots: Option<u32>,
+    roster: &[crate::config::Robot<'_>],
+    out_dir: &Path,
+) -> Result<(), LaunchError> {
+    let mut tables = serde_json::Map::new();
+    for robot in roster {
+        let controller = &robot.epuck.controller;
+        if tables.contains_key(controller) {
+            continue;
+        }
+        let args = AgentArgs {
+            run: run_args.clone(),
+            robot: robot.index,
+            config: config.to_path_buf(),
+            seed,
+            robots,
+        };
+        let output = Command::new(&binaries.agent)
+            .args(args.to_args())
+            .arg("--check")
+            .stdin(Stdio::null())
+            .output()
+            .map_err(io(format!("starting {}", binaries.agent.display())))?;
+        if !output.status.success() {
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+            return Err(LaunchError::AgentFailed {
+                robot: robot.index,
+                id: robot.id.clone(),
+                status: exit_status(output.status),
+                log: lines[lines.len().saturating_sub(LOG_LINES_QUOTED)..].join("\n"),
+            });
+        }
+        let names: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap_or_default();
+        tables.insert(controller.clone(), names);
+    }
+    let path = out_dir.join(EVENT_TABLES_FILE);
+    let text = serde_json::to_string_pretty(&serde_json::Value::Object(tables)).unwrap_or_default();
+    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))
 }
 
 /// A seed from the clock, for configurations that ask for one.
@@ -379,7 +445,11 @@ struct Supervision {
 
 impl Supervision {
     /// Follows the run until the world finishes (or is stopped and finishes), handling deaths on the way.
-    fn follow(&mut self, reports: &Receiver<WorldReport>, stop: &AtomicBool) -> Result<(), LaunchError> {
+    fn follow(
+        &mut self,
+        reports: &Receiver<WorldReport>,
+        stop: &AtomicBool,
+    ) -> Result<(), LaunchError> {
         let mut stop_sent = false;
         loop {
             if stop.load(Ordering::Relaxed) && !stop_sent {
@@ -402,8 +472,10 @@ impl Supervision {
                     self.last_tick = tick;
                     self.progress.set_position(tick);
                     let total = self.roster_ids.len() as u32;
-                    self.progress
-                        .set_message(format!("{}/{total} robots alive", total.saturating_sub(dead)));
+                    self.progress.set_message(format!(
+                        "{}/{total} robots alive",
+                        total.saturating_sub(dead)
+                    ));
                 }
                 Ok(WorldReport::Finished { ticks }) => {
                     self.last_tick = ticks;
@@ -429,10 +501,15 @@ impl Supervision {
     fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
         for (robot, status) in self.children.reap_agents() {
             if self.first_tick.is_none() {
-                let log = run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
+                let log =
+                    run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
                 return Err(LaunchError::AgentFailed {
                     robot,
-                    id: self.roster_ids.get(robot as usize).cloned().unwrap_or_default(),
+                    id: self
+                        .roster_ids
+                        .get(robot as usize)
+                        .cloned()
+                        .unwrap_or_default(),
                     status: exit_status(status),
                     log,
                 });
@@ -475,7 +552,10 @@ impl Supervision {
         }
         let stragglers = self.children.agents_running();
         if stragglers > 0 {
-            tracing::warn!(stragglers, "agents did not exit after the run; killing them");
+            tracing::warn!(
+                stragglers,
+                "agents did not exit after the run; killing them"
+            );
         }
         self.children.kill_all();
     }

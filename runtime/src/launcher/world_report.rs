@@ -41,7 +41,10 @@ impl fmt::Display for WorldReport {
                 answered,
                 missing,
                 dead,
-            } => write!(f, "tick {tick} answered {answered} missing {missing} dead {dead}"),
+            } => write!(
+                f,
+                "tick {tick} answered {answered} missing {missing} dead {dead}"
+            ),
             WorldReport::Finished { ticks } => write!(f, "finished {ticks}"),
         }
     }
@@ -55,14 +58,21 @@ impl WorldReport {
             ["ready", robots] => Some(WorldReport::Ready {
                 robots: robots.parse().ok()?,
             }),
-            ["tick", tick, "answered", answered, "missing", missing, "dead", dead] => {
-                Some(WorldReport::Tick {
-                    tick: tick.parse().ok()?,
-                    answered: answered.parse().ok()?,
-                    missing: missing.parse().ok()?,
-                    dead: dead.parse().ok()?,
-                })
-            }
+            [
+                "tick",
+                tick,
+                "answered",
+                answered,
+                "missing",
+                missing,
+                "dead",
+                dead,
+            ] => Some(WorldReport::Tick {
+                tick: tick.parse().ok()?,
+                answered: answered.parse().ok()?,
+                missing: missing.parse().ok()?,
+                dead: dead.parse().ok()?,
+            }),
             ["finished", ticks] => Some(WorldReport::Finished {
                 ticks: ticks.parse().ok()?,
             }),
@@ -93,7 +103,13 @@ mod tests {
 
     #[test]
     fn other_lines_are_not_reports() {
-        for line in ["", "ready", "ready forty", "tick 1 answered 2", "hello world"] {
+        for line in [
+            "",
+            "ready",
+            "ready forty",
+            "tick 1 answered 2",
+            "hello world",
+        ] {
             assert_eq!(WorldReport::parse(line), None, "{line:?}");
         }
     }

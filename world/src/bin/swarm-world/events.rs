@@ -10,12 +10,11 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use anyhow::Context;
+use swarm_runtime::launcher::EVENT_TABLES_FILE;
 use swarm_runtime::messages::ActuatorCommand;
 
 /// File name of the event record in the run directory.
 pub const EVENTS_FILE: &str = "events.csv";
-/// File the launcher writes with each controller's event names.
-pub const EVENT_TABLES_FILE: &str = "event_tables.json";
 
 /// Writes `events.csv`.
 pub struct EventsWriter {
@@ -40,7 +39,12 @@ impl EventsWriter {
         writeln!(out, "tick,robot,robot_id,event")?;
         let robots = robots
             .iter()
-            .map(|(id, controller)| (id.clone(), tables.get(controller).cloned().unwrap_or_default()))
+            .map(|(id, controller)| {
+                (
+                    id.clone(),
+                    tables.get(controller).cloned().unwrap_or_default(),
+                )
+            })
             .collect();
         Ok(EventsWriter { out, robots })
     }

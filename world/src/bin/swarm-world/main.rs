@@ -71,7 +71,10 @@ fn follow_death_notices(notices: DeathNotices) -> Receiver<u32> {
     std::thread::spawn(move || {
         for line in std::io::stdin().lock().lines() {
             let Ok(line) = line else { break };
-            let Some(robot) = line.strip_prefix("dead ").and_then(|r| r.trim().parse::<u32>().ok()) else {
+            let Some(robot) = line
+                .strip_prefix("dead ")
+                .and_then(|r| r.trim().parse::<u32>().ok())
+            else {
                 continue;
             };
             if let Err(e) = notices.mark_dead(robot) {
@@ -89,7 +92,8 @@ fn follow_death_notices(notices: DeathNotices) -> Receiver<u32> {
 fn run(args: &WorldArgs) -> anyhow::Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
-    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).context("installing the stop handler")?;
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the stop handler")?;
 
     let (experiment, _warnings) = Experiment::load(&args.config)?;
     let experiment = match args.robots {
@@ -122,13 +126,18 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     link.wait_for_agents(Duration::from_millis(args.join_timeout_ms))
         .context("waiting for the robot agents to join")?;
     let started = Instant::now();
-    let mut commands: Vec<ActuatorCommand> = (0..robots).map(|i| ActuatorCommand::idle(i as u32, 0)).collect();
+    let mut commands: Vec<ActuatorCommand> = (0..robots)
+        .map(|i| ActuatorCommand::idle(i as u32, 0))
+        .collect();
     let mut has_command = vec![false; robots];
     let mut dead = vec![false; robots];
     let mut robot_steps: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
-    while !stop.load(Ordering::Relaxed) && !world.is_finished() && (args.ticks == 0 || link.tick() < args.ticks) {
+    while !stop.load(Ordering::Relaxed)
+        && !world.is_finished()
+        && (args.ticks == 0 || link.tick() < args.ticks)
+    {
         for robot in deaths.try_iter() {
             if let Some(flag) = dead.get_mut(robot as usize) {
                 *flag = true;
