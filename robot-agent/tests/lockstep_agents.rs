@@ -29,7 +29,7 @@ impl Run {
                 &robot.to_string(),
                 "--seed",
                 "124",
-                "--root",
+                "--iox-root",
             ])
             .arg(self.spec.root_dir())
             .args(controller)
