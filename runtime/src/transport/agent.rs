@@ -19,7 +19,7 @@ use super::sync_block::{JoinClaim, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// Default number of polls of the tick word before an agent sleeps on it (see [`AgentLink::set_spin`]).
-pub const DEFAULT_AGENT_SPIN: u32 = 64;
+pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
 /// One tick's frame of this agent's robot, read in place from the world's shared-memory sample.
 pub struct TickFrame {
@@ -154,8 +154,8 @@ impl AgentLink {
         self.robot
     }
 
-    /// How many times the agent polls the tick word before it sleeps on it (default 64). Polling only pays when
-    /// the machine has a core to spare for every agent.
+    /// How many times the agent polls the tick word before it sleeps on it (default 0: the lockstep benchmark
+    /// on 2 cores is fastest without agent polling). Polling only pays when every agent has a core to itself.
     pub fn set_spin(&mut self, polls: u32) {
         self.spin = polls;
     }
@@ -168,17 +168,21 @@ impl AgentLink {
             if self.sync.stopped() {
                 return Ok(None);
             }
-            if self
+            let newest = if self.pending.is_none() {
+                self.receive_frames()?
+            } else if self
                 .frame_subscriber
                 .has_samples()
                 .map_err(|e| TransportError::iceoryx("checking for frames", e))?
             {
                 // Only one frame sample is ever borrowed: release the older one first.
                 self.pending = None;
-                self.pending = self
-                    .frame_subscriber
-                    .receive()
-                    .map_err(|e| TransportError::iceoryx("receiving the frames", e))?;
+                self.receive_frames()?
+            } else {
+                None
+            };
+            if newest.is_some() {
+                self.pending = newest;
             }
             if let Some(sample) = self.pending.take() {
                 let Some(frame) = sample.payload().get(index) else {
@@ -201,6 +205,14 @@ impl AgentLink {
             }
             self.seen_epoch = self.sync.wait_epoch_change(self.seen_epoch, self.spin);
         }
+    }
+
+    fn receive_frames(
+        &self,
+    ) -> Result<Option<Sample<ipc::Service, [SensorFrame], ()>>, TransportError> {
+        self.frame_subscriber
+            .receive()
+            .map_err(|e| TransportError::iceoryx("receiving the frames", e))
     }
 
     /// Sends `command` as this robot's answer to `frame`'s tick (its `tick` and `robot` fields are set from the
