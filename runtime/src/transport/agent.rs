@@ -161,7 +161,8 @@ impl AgentLink {
     }
 
     /// Waits for the next tick the world opens and returns this robot's frame; `None` when the world ended the
-    /// run. An agent that fell behind skips straight to the newest tick.
+    /// run, [`TransportError::WorldGone`] when the world process died without ending it (checked every second
+    /// of silence). An agent that fell behind skips straight to the newest tick.
     pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
         let index = self.robot as usize;
         loop {
@@ -203,7 +204,10 @@ impl AgentLink {
                     self.pending = Some(sample);
                 }
             }
-            self.seen_epoch = self.sync.wait_epoch_change(self.seen_epoch, self.spin);
+            self.seen_epoch = self
+                .sync
+                .wait_epoch_change(self.seen_epoch, self.spin)
+                .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }
 
