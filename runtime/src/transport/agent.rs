@@ -39,17 +39,22 @@ impl TickFrame {
     }
 }
 
+/// The iceoryx2 side of an agent: its node, and its ports on the frame service and its robot's command service.
+struct Ports {
+    frame_subscriber: Subscriber<ipc::Service, [SensorFrame], ()>,
+    command_publisher: Publisher<ipc::Service, ActuatorCommand, ()>,
+    _command_service: CommandService,
+    _frame_service: FrameService,
+    _node: Node<ipc::Service>,
+}
+
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
     spin: u32,
     seen_epoch: u32,
     pending: Option<Sample<ipc::Service, [SensorFrame], ()>>,
-    frame_subscriber: Subscriber<ipc::Service, [SensorFrame], ()>,
-    command_publisher: Publisher<ipc::Service, ActuatorCommand, ()>,
-    _command_service: CommandService,
-    _frame_service: FrameService,
-    _node: Node<ipc::Service>,
+    ports: Ports,
     sync: SyncBlock,
 }
 
@@ -66,7 +71,7 @@ impl AgentLink {
             return Err(TransportError::RobotTaken { robot });
         }
         match Self::connect(run, robot, capacity) {
-            Ok((node, frame_service, frame_subscriber, command_service, command_publisher)) => {
+            Ok(ports) => {
                 let seen_epoch = sync.epoch();
                 sync.announce_ready(robot);
                 Ok(AgentLink {
@@ -74,11 +79,7 @@ impl AgentLink {
                     spin: DEFAULT_AGENT_SPIN,
                     seen_epoch,
                     pending: None,
-                    frame_subscriber,
-                    command_publisher,
-                    _command_service: command_service,
-                    _frame_service: frame_service,
-                    _node: node,
+                    ports,
                     sync,
                 })
             }
@@ -89,21 +90,7 @@ impl AgentLink {
         }
     }
 
-    #[allow(clippy::type_complexity)]
-    fn connect(
-        run: &RunSpec,
-        robot: u32,
-        capacity: u32,
-    ) -> Result<
-        (
-            Node<ipc::Service>,
-            FrameService,
-            Subscriber<ipc::Service, [SensorFrame], ()>,
-            CommandService,
-            Publisher<ipc::Service, ActuatorCommand, ()>,
-        ),
-        TransportError,
-    > {
+    fn connect(run: &RunSpec, robot: u32, capacity: u32) -> Result<Ports, TransportError> {
         let node = services::node(run, &format!("robot-{robot}"))?;
         let frame_service = services::open_frame_service(&node)?;
         let frame_subscriber =
@@ -140,13 +127,13 @@ impl AgentLink {
                         other,
                     ),
                 })?;
-        Ok((
-            node,
-            frame_service,
+        Ok(Ports {
             frame_subscriber,
-            command_service,
             command_publisher,
-        ))
+            _command_service: command_service,
+            _frame_service: frame_service,
+            _node: node,
+        })
     }
 
     /// The robot this agent runs.
@@ -172,6 +159,7 @@ impl AgentLink {
             let newest = if self.pending.is_none() {
                 self.receive_frames()?
             } else if self
+                .ports
                 .frame_subscriber
                 .has_samples()
                 .map_err(|e| TransportError::iceoryx("checking for frames", e))?
@@ -214,7 +202,8 @@ impl AgentLink {
     fn receive_frames(
         &self,
     ) -> Result<Option<Sample<ipc::Service, [SensorFrame], ()>>, TransportError> {
-        self.frame_subscriber
+        self.ports
+            .frame_subscriber
             .receive()
             .map_err(|e| TransportError::iceoryx("receiving the frames", e))
     }
@@ -231,7 +220,7 @@ impl AgentLink {
         let mut answer = *command;
         answer.tick = tick;
         answer.robot = self.robot;
-        let sample = self.command_publisher.loan_uninit().map_err(|e| {
+        let sample = self.ports.command_publisher.loan_uninit().map_err(|e| {
             TransportError::iceoryx(format!("loaning the command of tick {tick}"), e)
         })?;
         sample.write_payload(answer).send().map_err(|e| {
