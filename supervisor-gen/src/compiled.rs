@@ -615,7 +615,7 @@ fn compile_supervisor(
                     event: tr.event.0,
                 })?;
             let ctrl = events.is_controllable(tr.event);
-            let located = |_: ()| {
+            let located = || {
                 (
                     a.name().to_owned(),
                     a.state_name(sid).to_owned(),
@@ -624,7 +624,7 @@ fn compile_supervisor(
             };
             let (prob_q16, lower_bound) = if ctrl {
                 if !(0.0..=1.0).contains(&tr.prob) {
-                    let (supervisor, state, event) = located(());
+                    let (supervisor, state, event) = located();
                     return Err(CodegenError::ProbabilityOutOfRange {
                         supervisor,
                         state,
@@ -633,7 +633,7 @@ fn compile_supervisor(
                     });
                 }
                 let lb = u16::try_from(tr.lower_bound).map_err(|_| {
-                    let (supervisor, state, event) = located(());
+                    let (supervisor, state, event) = located();
                     CodegenError::LowerBoundTooLarge {
                         supervisor,
                         state,
@@ -645,6 +645,7 @@ fn compile_supervisor(
             } else {
                 (u16::MAX, 0)
             };
+            // Automaton builders only accept existing targets, so the lookup always succeeds.
             let target = new_id.get(tr.target.index()).copied().unwrap_or(0);
             transitions.push((
                 !ctrl,
