@@ -36,6 +36,27 @@ pub fn controller_of(experiment: &Experiment, robot: u32) -> Result<&Controller,
         })
 }
 
+/// The controller with id `id` (the launcher names it explicitly).
+pub fn controller_by_id<'a>(
+    experiment: &'a Experiment,
+    id: &str,
+) -> Result<&'a Controller, Diagnostic> {
+    experiment.controller(id).ok_or_else(|| {
+        let declared: Vec<String> = experiment
+            .controllers
+            .iter()
+            .map(|c| format!("`{}`", c.id))
+            .collect();
+        experiment.diagnostic(
+            Location { line: 0, column: 0 },
+            format!(
+                "no controller with id `{id}` (declared: {})",
+                declared.join(", ")
+            ),
+        )
+    })
+}
+
 /// The `<params>` attributes of `controller`.
 pub fn params_of(controller: &Controller) -> Params {
     Params::new(
@@ -114,6 +135,15 @@ mod tests {
         let e = experiment();
         assert_eq!(controller_of(&e, 0).unwrap().id, "fdc");
         assert_eq!(controller_of(&e, 1).unwrap().id, "bad");
+    }
+
+    #[test]
+    fn unknown_controller_id_lists_the_declared_ones() {
+        let e = experiment();
+        assert_eq!(
+            controller_by_id(&e, "x").unwrap_err().to_string(),
+            "/cfg/two.argos: no controller with id `x` (declared: `fdc`, `bad`)"
+        );
     }
 
     #[test]

@@ -24,9 +24,9 @@ struct Args {
     /// Run name (shared by every process of the run).
     #[arg(long)]
     run: String,
-    /// iceoryx2 root directory of the run (absolute).
-    #[arg(long, required_unless_present = "check")]
-    root: Option<PathBuf>,
+    /// Absolute iceoryx2 root directory of the run.
+    #[arg(long = "iox-root", required_unless_present = "check")]
+    iox_root: Option<PathBuf>,
     /// Index of this robot in the run (0..N).
     #[arg(long)]
     robot: u32,
@@ -37,6 +37,9 @@ struct Args {
     /// Experiment configuration (.argos); the robot runs the controller its `<e-puck>` names.
     #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
     config: Option<PathBuf>,
+    /// With --config: id of the robot's controller in `<controllers>` (default: the one its `<e-puck>` names).
+    #[arg(long, requires = "config")]
+    controller: Option<String>,
     /// Without --config: controller element name, as a `<controllers>` child would be named.
     #[arg(long, default_value = "")]
     element: String,
@@ -87,7 +90,10 @@ fn build_control(args: &Args) -> Result<Control> {
                 path.display()
             ),
         };
-        let controller = from_config::controller_of(&experiment, args.robot)?;
+        let controller = match &args.controller {
+            Some(id) => from_config::controller_by_id(&experiment, id)?,
+            None => from_config::controller_of(&experiment, args.robot)?,
+        };
         let (plan, control) = from_config::build(&experiment, controller, seed, args.robot)?;
         info!(
             controller = controller.id.as_str(),
@@ -131,7 +137,7 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
 fn run(args: &Args) -> Result<()> {
     let mut control = build_control(args)
         .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
-    let Some(root) = args.root.as_deref().filter(|_| !args.check) else {
+    let Some(root) = args.iox_root.as_deref().filter(|_| !args.check) else {
         info!(robot = args.robot, "controller checked");
         println!("{}", serde_json::to_string(&control.event_names())?);
         return Ok(());
@@ -144,7 +150,7 @@ fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info,supervisor_gen=warn")),
         )
         .with_writer(std::io::stderr)
         .init();

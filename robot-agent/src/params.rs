@@ -62,11 +62,6 @@ impl Params {
             .map(|(_, v)| v.as_str())
     }
 
-    /// All parameters, in document order.
-    pub fn iter(&self) -> impl Iterator<Item = (&str, &str)> {
-        self.entries.iter().map(|(k, v)| (k.as_str(), v.as_str()))
-    }
-
     /// `name` as a finite `f32`, or `default` when absent.
     pub fn f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
         let Some(raw) = self.get(name) else {

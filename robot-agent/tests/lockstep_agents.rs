@@ -29,7 +29,7 @@ impl Run {
                 &robot.to_string(),
                 "--seed",
                 "124",
-                "--root",
+                "--iox-root",
             ])
             .arg(self.spec.root_dir())
             .args(controller)
@@ -69,6 +69,8 @@ fn native_and_supervised_agents_answer_every_tick_and_exit_when_the_run_ends() {
         &[
             "--config",
             "configs/obstacle_avoidance/thesis_example.argos",
+            "--controller",
+            "fdc",
         ],
     );
     world.wait_for_agents(JOIN_TIMEOUT).unwrap();

@@ -223,3 +223,26 @@ fn cleanup_after_sigkill_of_every_process_leaves_nothing_in_dev_shm() {
     run.spec.cleanup().expect("cleanup");
     assert_eq!(run.spec.leftovers(), Vec::<std::path::PathBuf>::new());
 }
+
+#[test]
+fn replacement_agent_joins_after_a_death_notice_and_answers_again() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(3, 300)).expect("create world");
+    for robot in 0..3 {
+        let extra: &[&str] = if robot == 1 { &["--die-at", "2"] } else { &[] };
+        run.spawn(robot, extra);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 3);
+    assert_eq!(world.tick_with(sense).expect("tick 2").missing, 1);
+    world.mark_dead(1).expect("death notice");
+    // This tick does not wait for robot 1 and removes the dead agent's iceoryx2 node.
+    assert_eq!(world.tick_with(sense).expect("tick 3").dead, 1);
+    run.spawn(1, &[]);
+    world
+        .wait_for_agents(JOIN_TIMEOUT)
+        .expect("replacement joins");
+    let outcome = world.tick_with(sense).expect("tick 4");
+    assert_eq!(outcome.answered, 3, "{outcome:?}");
+    expect_echo(&world, 1, 4);
+}

@@ -10,9 +10,11 @@ use std::fmt::Write as _;
 
 use crate::compiled::SupervisorSet;
 
-/// Turns a model name into a lowercase Rust identifier fragment (`return-not-in-home` → `return_not_in_home`).
+/// Turns a model name into a lowercase Rust identifier (`return-not-in-home` → `return_not_in_home`). Names that
+/// would not start with a letter (`2nd`, `-`, the empty name) get an `e_` prefix, so the uppercase form is also a
+/// valid constant name.
 pub fn sanitise(name: &str) -> String {
-    let mut s: String = name
+    let s: String = name
         .chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() {
@@ -22,10 +24,11 @@ pub fn sanitise(name: &str) -> String {
             }
         })
         .collect();
-    if s.is_empty() {
-        s.push('_');
+    if s.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        s
+    } else {
+        format!("e_{s}")
     }
-    s
 }
 
 /// One identifier fragment per event, unique after sanitising.
@@ -281,5 +284,13 @@ mod tests {
         let set = set_with(&[("a-b", true), ("a_b", true)]);
         let src = generate_rust(&set, "test");
         assert!(src.contains("fn act_a_b_0(") && src.contains("fn act_a_b_1("));
+    }
+
+    #[test]
+    fn names_not_starting_with_a_letter_get_a_prefix() {
+        assert_eq!(sanitise("2nd-turn"), "e_2nd_turn");
+        assert_eq!(sanitise(""), "e_");
+        assert_eq!(sanitise("_x"), "e__x");
+        assert_eq!(sanitise("Go Left"), "go_left");
     }
 }

@@ -615,7 +615,7 @@ fn compile_supervisor(
                     event: tr.event.0,
                 })?;
             let ctrl = events.is_controllable(tr.event);
-            let located = |_: ()| {
+            let located = || {
                 (
                     a.name().to_owned(),
                     a.state_name(sid).to_owned(),
@@ -624,7 +624,7 @@ fn compile_supervisor(
             };
             let (prob_q16, lower_bound) = if ctrl {
                 if !(0.0..=1.0).contains(&tr.prob) {
-                    let (supervisor, state, event) = located(());
+                    let (supervisor, state, event) = located();
                     return Err(CodegenError::ProbabilityOutOfRange {
                         supervisor,
                         state,
@@ -633,7 +633,7 @@ fn compile_supervisor(
                     });
                 }
                 let lb = u16::try_from(tr.lower_bound).map_err(|_| {
-                    let (supervisor, state, event) = located(());
+                    let (supervisor, state, event) = located();
                     CodegenError::LowerBoundTooLarge {
                         supervisor,
                         state,
@@ -645,6 +645,7 @@ fn compile_supervisor(
             } else {
                 (u16::MAX, 0)
             };
+            // Automaton builders only accept existing targets, so the lookup always succeeds.
             let target = new_id.get(tr.target.index()).copied().unwrap_or(0);
             transitions.push((
                 !ctrl,
@@ -983,28 +984,42 @@ mod tests {
         (ev, g)
     }
 
-    const WORKED_PAYLOAD: [u8; 57] = [
-        // δ (21 B)
-        0x02, 0x00, 0x00, 0x01, 0x01, 0x00, 0x02, 0x02, 0x00, 0x00, 0x01, 0x03, 0x00, 0x00, 0x02,
-        0x01, 0x00, 0x00, 0x02, 0x00, 0x01, // P (13 B)
-        0x02, 0xCC, 0xCC, 0x33, 0x33, 0x01, 0xFF, 0xFF, 0x02, 0x40, 0x00, 0xBF,
-        0xFF, // T (13 B)
-        0x02, 0x00, 0x02, 0x00, 0x00, 0x01, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00,
-        0x00, // ctrl (4 B)
-        0x01, 0x01, 0x01, 0x00, // member (4 B)
-        0x01, 0x01, 0x01, 0x01, // current (2 B)
-        0x00, 0x00,
+    /// The arrays of the worked example, as printed in section 9.
+    const WORKED_DELTA: [u8; 21] = [
+        0x02, 0x00, 0x00, 0x01, 0x01, 0x00, 0x02, //
+        0x02, 0x00, 0x00, 0x01, 0x03, 0x00, 0x00, //
+        0x02, 0x01, 0x00, 0x00, 0x02, 0x00, 0x01,
     ];
+    const WORKED_P: [u8; 13] = [
+        0x02, 0xCC, 0xCC, 0x33, 0x33, 0x01, 0xFF, 0xFF, 0x02, 0x40, 0x00, 0xBF, 0xFF,
+    ];
+    const WORKED_T: [u8; 13] = [
+        0x02, 0x00, 0x02, 0x00, 0x00, 0x01, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x00,
+    ];
+    const WORKED_CTRL: [u8; 4] = [0x01, 0x01, 0x01, 0x00];
+    const WORKED_MEMBER: [u8; 4] = [0x01, 0x01, 0x01, 0x01];
+    const WORKED_CURRENT: [u8; 2] = [0x00, 0x00];
+
+    fn worked_payload() -> Vec<u8> {
+        [
+            &WORKED_DELTA[..],
+            &WORKED_P,
+            &WORKED_T,
+            &WORKED_CTRL,
+            &WORKED_MEMBER,
+            &WORKED_CURRENT,
+        ]
+        .concat()
+    }
 
     #[test]
     fn worked_example_of_section_9_gives_the_thesis_bytes_and_memcons_57() {
         let (ev, g) = worked_example();
         let set = SupervisorSet::from_supervisors(&ev, std::slice::from_ref(&g)).unwrap();
         let bytes = set.to_bytes();
-        assert!(
-            bytes.ends_with(&WORKED_PAYLOAD),
-            "payload differs: {bytes:02X?}"
-        );
+        let payload = worked_payload();
+        assert_eq!(payload.len(), 21 + 13 + 13 + 4 + 4 + 2);
+        assert!(bytes.ends_with(&payload), "payload differs: {bytes:02X?}");
         assert_eq!(set.mem_cons(), 57);
         assert_eq!(mem_cons_of(&ev, &[&g]), 57);
         // Header: magic, version, counts, 4 one-letter event names, one supervisor entry.

@@ -117,10 +117,7 @@ pub struct Synthesis {
 impl Synthesis {
     /// The final supervisors, in order.
     pub fn final_supervisors(&self) -> Vec<Automaton> {
-        self.supervisors
-            .iter()
-            .map(|s| s.supervisor.clone())
-            .collect()
+        finals(&self.supervisors)
     }
 
     /// Compiles the final supervisors into the section 9 byte layout (fails on V15 limits).

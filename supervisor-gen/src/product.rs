@@ -81,9 +81,15 @@ pub fn product_with_tuples(
     let mut next = vec![0u32; arity];
     let mut buf: Vec<Transition> = Vec::new();
     let mut name = String::new();
+    // Components moved by the transition being built: (component, new state).
+    let mut moved: Vec<(usize, u32)> = Vec::with_capacity(arity);
+    let strides: Option<Vec<usize>> = index.strides().map(<[usize]>::to_vec);
     let mut x = 0usize;
     while x < index.len() {
         cur.copy_from_slice(index.tuple(x));
+        let cur_key: usize = strides.as_ref().map_or(0, |st| {
+            cur.iter().zip(st).map(|(&q, &w)| q as usize * w).sum()
+        });
         buf.clear();
         for (c, part) in parts.iter().enumerate() {
             for tr in part.transitions(StateId(cur[c])) {
@@ -91,14 +97,14 @@ pub fn product_with_tuples(
                 if own[0] != c {
                     continue;
                 }
-                next.copy_from_slice(&cur);
-                next[c] = tr.target.0;
+                moved.clear();
+                moved.push((c, tr.target.0));
                 let (mut prob, mut lb) = (tr.prob, tr.lower_bound);
                 let mut enabled = true;
                 for &o in &own[1..] {
                     match parts[o].transition(StateId(cur[o]), tr.event) {
                         Some(t2) => {
-                            next[o] = t2.target.0;
+                            moved.push((o, t2.target.0));
                             prob *= t2.prob;
                             lb = lb.max(t2.lower_bound);
                         }
@@ -111,7 +117,32 @@ pub fn product_with_tuples(
                 if !enabled {
                     continue;
                 }
-                let target = index.find_or_insert(&next);
+                let target = match &strides {
+                    // Direct addressing: update the key by the moved components only, and build the tuple
+                    // only when it is new.
+                    Some(st) => {
+                        let key = moved.iter().fold(cur_key, |k, &(i, q)| {
+                            k - cur[i] as usize * st[i] + q as usize * st[i]
+                        });
+                        match index.dense_get(key) {
+                            Some(id) => id,
+                            None => {
+                                next.copy_from_slice(&cur);
+                                for &(i, q) in &moved {
+                                    next[i] = q;
+                                }
+                                index.dense_insert(key, &next)
+                            }
+                        }
+                    }
+                    None => {
+                        next.copy_from_slice(&cur);
+                        for &(i, q) in &moved {
+                            next[i] = q;
+                        }
+                        index.find_or_insert(&next)
+                    }
+                };
                 let ctrl = events.is_controllable(tr.event);
                 buf.push(Transition {
                     event: tr.event,
@@ -204,6 +235,32 @@ impl TupleIndex {
 
     fn tuple(&self, x: usize) -> &[u32] {
         &self.tuples[x * self.arity..(x + 1) * self.arity]
+    }
+
+    /// The strides of the direct-address key, if this index uses direct addressing.
+    fn strides(&self) -> Option<&[usize]> {
+        match &self.lookup {
+            Lookup::Dense { strides, .. } => Some(strides),
+            Lookup::Hashed { .. } => None,
+        }
+    }
+
+    /// The id stored under a direct-address key, if any (`None` also for a hashed index).
+    fn dense_get(&self, key: usize) -> Option<u32> {
+        match &self.lookup {
+            Lookup::Dense { slots, .. } => Some(slots[key]).filter(|&id| id != EMPTY),
+            Lookup::Hashed { .. } => None,
+        }
+    }
+
+    /// Adds tuple `t`, whose direct-address key is `key` and which is not yet present, and returns its id.
+    fn dense_insert(&mut self, key: usize, t: &[u32]) -> u32 {
+        let id = self.len() as u32;
+        if let Lookup::Dense { slots, .. } = &mut self.lookup {
+            slots[key] = id;
+        }
+        self.tuples.extend_from_slice(t);
+        id
     }
 
     fn hash(t: &[u32]) -> usize {
@@ -357,5 +414,33 @@ mod tests {
             }
             assert_eq!(idx.len(), n as usize);
         }
+    }
+
+    /// Two components of 2100 states (a tuple space above DENSE_LIMIT) whose reachable parts are two-state
+    /// cycles give the same product through the hashed index as their accessible parts give through the dense one.
+    #[test]
+    fn hashed_and_dense_products_agree() {
+        let mut ev = EventTable::new();
+        let a = ev.intern("a", true).unwrap();
+        let b = ev.intern("b", false).unwrap();
+        let c = ev.intern("c", true).unwrap();
+        let build = |name: &str, own: EventId, states: usize| {
+            let mut g = Automaton::new(name, ModelKind::Spec);
+            for i in 0..states {
+                g.add_state(format!("s{i}"), i == 0).unwrap();
+            }
+            g.add_transition(StateId(0), own, StateId(1), 0.5, 1)
+                .unwrap();
+            g.add_transition(StateId(1), a, StateId(0), 0.5, 2).unwrap();
+            g
+        };
+        let (g, h) = (build("g", b, 2100), build("h", c, 2100));
+        assert!(TupleIndex::new(&[2100, 2100]).strides().is_none());
+        let hashed = product_with_tuples("k", ModelKind::Spec, &ev, &[&g, &h]);
+        let (gs, hs) = (build("g", b, 2), build("h", c, 2));
+        let dense = product_with_tuples("k", ModelKind::Spec, &ev, &[&gs, &hs]);
+        assert_eq!(hashed.automaton, dense.automaton);
+        assert_eq!(hashed.tuples, dense.tuples);
+        assert_eq!(dense.automaton.state_count(), 4);
     }
 }

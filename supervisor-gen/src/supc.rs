@@ -2,7 +2,10 @@
 //!
 //! Bad states (6.3) are found once from the plant and then propagated backwards along uncontrollable plant events
 //! with a worklist, so each round costs one closure plus one trim; rounds repeat while trimming uncovers new
-//! bad states. Every removal is recorded with its reason and round, for the report and the drawings.
+//! bad states. The fixpoint is the one of the section 6.5 loop; only the round numbers differ, because a state
+//! that the literal loop would find bad one round later (through an uncontrollable event into a state removed
+//! this round) is caught by the closure of the same round. Every removal is recorded with its reason and round,
+//! for the report and the drawings.
 //! P and T labels of surviving transitions are never changed here.
 
 use crate::automaton::{Automaton, EventId, EventTable, StateId};
@@ -273,5 +276,54 @@ mod tests {
         assert_eq!(reasons[1].1, RemovalReason::NonCoaccessible);
         assert_eq!(r.supervisor.state_count(), 1);
         assert_eq!(r.supervisor.transition_count(), 0);
+    }
+
+    /// A state reachable only through a bad state is recorded as inaccessible, not as bad.
+    #[test]
+    fn states_cut_off_by_a_bad_state_are_recorded_as_inaccessible() {
+        let mut ev = EventTable::new();
+        let a = ev.intern("a", true).unwrap();
+        let b = ev.intern("b", true).unwrap();
+        let c = ev.intern("c", true).unwrap();
+        let u = ev.intern("u", false).unwrap();
+        // Plant: g0 -a-> g1 -b-> g2 -c-> g0, and u is possible in g1; g0 and g2 are marked.
+        let mut g = Automaton::new("G", ModelKind::Plant);
+        let s: Vec<_> = (0..3)
+            .map(|i| g.add_state(format!("g{i}"), i != 1).unwrap())
+            .collect();
+        g.add_transition(s[0], a, s[1], 1.0, 0).unwrap();
+        g.add_transition(s[1], b, s[2], 1.0, 0).unwrap();
+        g.add_transition(s[2], c, s[0], 1.0, 0).unwrap();
+        g.add_transition(s[1], u, s[1], 1.0, 0).unwrap();
+        // Spec: a, b, c are free; u is never allowed.
+        let mut e = Automaton::new("E", ModelKind::Spec);
+        let e0 = e.add_state("e0", true).unwrap();
+        for ev_id in [a, b, c] {
+            e.add_transition(e0, ev_id, e0, 1.0, 0).unwrap();
+        }
+        e.add_event(u);
+        let (_, r) = run(&ev, &g, &e);
+        let reasons: Vec<_> = r
+            .removed
+            .iter()
+            .map(|x| (x.name.as_str(), x.reason))
+            .collect();
+        assert_eq!(
+            reasons,
+            vec![
+                (
+                    "(g1,e0)",
+                    RemovalReason::Bad {
+                        event: u,
+                        target: None
+                    }
+                ),
+                ("(g2,e0)", RemovalReason::Inaccessible),
+            ]
+        );
+        assert_eq!(
+            (r.supervisor.state_count(), r.supervisor.transition_count()),
+            (1, 0)
+        );
     }
 }

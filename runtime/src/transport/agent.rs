@@ -19,7 +19,7 @@ use super::sync_block::{JoinClaim, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// Default number of polls of the tick word before an agent sleeps on it (see [`AgentLink::set_spin`]).
-pub const DEFAULT_AGENT_SPIN: u32 = 64;
+pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
 /// One tick's frame of this agent's robot, read in place from the world's shared-memory sample.
 pub struct TickFrame {
@@ -39,17 +39,22 @@ impl TickFrame {
     }
 }
 
+/// The iceoryx2 side of an agent: its node, and its ports on the frame service and its robot's command service.
+struct Ports {
+    frame_subscriber: Subscriber<ipc::Service, [SensorFrame], ()>,
+    command_publisher: Publisher<ipc::Service, ActuatorCommand, ()>,
+    _command_service: CommandService,
+    _frame_service: FrameService,
+    _node: Node<ipc::Service>,
+}
+
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
     spin: u32,
     seen_epoch: u32,
     pending: Option<Sample<ipc::Service, [SensorFrame], ()>>,
-    frame_subscriber: Subscriber<ipc::Service, [SensorFrame], ()>,
-    command_publisher: Publisher<ipc::Service, ActuatorCommand, ()>,
-    _command_service: CommandService,
-    _frame_service: FrameService,
-    _node: Node<ipc::Service>,
+    ports: Ports,
     sync: SyncBlock,
 }
 
@@ -66,7 +71,7 @@ impl AgentLink {
             return Err(TransportError::RobotTaken { robot });
         }
         match Self::connect(run, robot, capacity) {
-            Ok((node, frame_service, frame_subscriber, command_service, command_publisher)) => {
+            Ok(ports) => {
                 let seen_epoch = sync.epoch();
                 sync.announce_ready(robot);
                 Ok(AgentLink {
@@ -74,11 +79,7 @@ impl AgentLink {
                     spin: DEFAULT_AGENT_SPIN,
                     seen_epoch,
                     pending: None,
-                    frame_subscriber,
-                    command_publisher,
-                    _command_service: command_service,
-                    _frame_service: frame_service,
-                    _node: node,
+                    ports,
                     sync,
                 })
             }
@@ -89,21 +90,7 @@ impl AgentLink {
         }
     }
 
-    #[allow(clippy::type_complexity)]
-    fn connect(
-        run: &RunSpec,
-        robot: u32,
-        capacity: u32,
-    ) -> Result<
-        (
-            Node<ipc::Service>,
-            FrameService,
-            Subscriber<ipc::Service, [SensorFrame], ()>,
-            CommandService,
-            Publisher<ipc::Service, ActuatorCommand, ()>,
-        ),
-        TransportError,
-    > {
+    fn connect(run: &RunSpec, robot: u32, capacity: u32) -> Result<Ports, TransportError> {
         let node = services::node(run, &format!("robot-{robot}"))?;
         let frame_service = services::open_frame_service(&node)?;
         let frame_subscriber =
@@ -140,13 +127,13 @@ impl AgentLink {
                         other,
                     ),
                 })?;
-        Ok((
-            node,
-            frame_service,
+        Ok(Ports {
             frame_subscriber,
-            command_service,
             command_publisher,
-        ))
+            _command_service: command_service,
+            _frame_service: frame_service,
+            _node: node,
+        })
     }
 
     /// The robot this agent runs.
@@ -154,31 +141,37 @@ impl AgentLink {
         self.robot
     }
 
-    /// How many times the agent polls the tick word before it sleeps on it (default 64). Polling only pays when
-    /// the machine has a core to spare for every agent.
+    /// How many times the agent polls the tick word before it sleeps on it (default 0: the lockstep benchmark
+    /// on 2 cores is fastest without agent polling). Polling only pays when every agent has a core to itself.
     pub fn set_spin(&mut self, polls: u32) {
         self.spin = polls;
     }
 
     /// Waits for the next tick the world opens and returns this robot's frame; `None` when the world ended the
-    /// run. An agent that fell behind skips straight to the newest tick.
+    /// run, [`TransportError::WorldGone`] when the world process died without ending it (checked every second
+    /// of silence). An agent that fell behind skips straight to the newest tick.
     pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
         let index = self.robot as usize;
         loop {
             if self.sync.stopped() {
                 return Ok(None);
             }
-            if self
+            let newest = if self.pending.is_none() {
+                self.receive_frames()?
+            } else if self
+                .ports
                 .frame_subscriber
                 .has_samples()
                 .map_err(|e| TransportError::iceoryx("checking for frames", e))?
             {
                 // Only one frame sample is ever borrowed: release the older one first.
                 self.pending = None;
-                self.pending = self
-                    .frame_subscriber
-                    .receive()
-                    .map_err(|e| TransportError::iceoryx("receiving the frames", e))?;
+                self.receive_frames()?
+            } else {
+                None
+            };
+            if newest.is_some() {
+                self.pending = newest;
             }
             if let Some(sample) = self.pending.take() {
                 let Some(frame) = sample.payload().get(index) else {
@@ -199,8 +192,20 @@ impl AgentLink {
                     self.pending = Some(sample);
                 }
             }
-            self.seen_epoch = self.sync.wait_epoch_change(self.seen_epoch, self.spin);
+            self.seen_epoch = self
+                .sync
+                .wait_epoch_change(self.seen_epoch, self.spin)
+                .map_err(|pid| TransportError::WorldGone { pid })?;
         }
+    }
+
+    fn receive_frames(
+        &self,
+    ) -> Result<Option<Sample<ipc::Service, [SensorFrame], ()>>, TransportError> {
+        self.ports
+            .frame_subscriber
+            .receive()
+            .map_err(|e| TransportError::iceoryx("receiving the frames", e))
     }
 
     /// Sends `command` as this robot's answer to `frame`'s tick (its `tick` and `robot` fields are set from the
@@ -215,7 +220,7 @@ impl AgentLink {
         let mut answer = *command;
         answer.tick = tick;
         answer.robot = self.robot;
-        let sample = self.command_publisher.loan_uninit().map_err(|e| {
+        let sample = self.ports.command_publisher.loan_uninit().map_err(|e| {
             TransportError::iceoryx(format!("loaning the command of tick {tick}"), e)
         })?;
         sample.write_payload(answer).send().map_err(|e| {

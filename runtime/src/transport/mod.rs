@@ -112,6 +112,12 @@ pub enum TransportError {
         /// How long the world waited.
         waited_ms: u128,
     },
+    /// The world process no longer exists and never ended the run.
+    #[error("the world process (pid {pid}) is gone without ending the run")]
+    WorldGone {
+        /// The world's process id.
+        pid: u32,
+    },
     /// An iceoryx2 operation failed.
     #[error("iceoryx2: {action}: {detail}")]
     Iceoryx {

@@ -27,6 +27,8 @@ const LAYOUT_VERSION: u32 = 1;
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
 const COUNT_MASK: u32 = (1 << COUNT_BITS) - 1;
+/// How long an agent sleeps on the tick word before it checks that the world still exists.
+const WORLD_CHECK: Duration = Duration::from_secs(1);
 /// Most robots one run can hold (the count field must not overflow into the tick tag).
 pub const MAX_ROBOTS: u32 = COUNT_MASK;
 
@@ -40,6 +42,8 @@ struct Header {
     magic: AtomicU64,
     version: AtomicU32,
     capacity: AtomicU32,
+    /// Process id of the world, so that agents notice when it is gone.
+    world_pid: AtomicU32,
     /// Current tick (full width), written before `epoch`.
     tick: AtomicU64,
     /// Low 32 bits of the current tick; agents sleep on it.
@@ -106,6 +110,9 @@ impl SyncBlock {
         let header = block.header();
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
+        header
+            .world_pid
+            .store(std::process::id(), Ordering::Relaxed);
         header.magic.store(MAGIC, Ordering::Release);
         Ok(block)
     }
@@ -385,22 +392,38 @@ impl SyncBlock {
     }
 
     /// Waits until the epoch word differs from `seen` (or the run stops), spinning `spin` times before blocking.
-    pub(crate) fn wait_epoch_change(&self, seen: u32, spin: u32) -> u32 {
+    /// Every [`WORLD_CHECK`] without a change it checks that the world process still exists; `Err(pid)` when it
+    /// is gone (killed without stopping the run).
+    pub(crate) fn wait_epoch_change(&self, seen: u32, spin: u32) -> Result<u32, u32> {
         let epoch = &self.header().epoch.0;
         for _ in 0..spin {
             let current = epoch.load(Ordering::Acquire);
             if current != seen {
-                return current;
+                return Ok(current);
             }
             std::hint::spin_loop();
         }
         loop {
             let current = epoch.load(Ordering::Acquire);
             if current != seen {
-                return current;
+                return Ok(current);
             }
-            futex::wait(epoch, seen, None);
+            let before = Instant::now();
+            futex::wait(epoch, seen, Some(WORLD_CHECK));
+            if before.elapsed() >= WORLD_CHECK && !self.world_alive() {
+                return Err(self.header().world_pid.load(Ordering::Relaxed));
+            }
         }
+    }
+
+    fn world_alive(&self) -> bool {
+        let pid = self.header().world_pid.load(Ordering::Relaxed);
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return false;
+        };
+        // SAFETY: signal 0 only checks that the process exists; nothing is delivered.
+        let result = unsafe { libc::kill(pid, 0) };
+        result == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
     }
 }
 
