@@ -8,13 +8,13 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use supervisor_gen::architecture::Architecture;
-use supervisor_gen::compiled::{CodegenError, CompiledFormatError, SupervisorSet};
-use supervisor_gen::convert::{ConvertError, to_project};
-use supervisor_gen::diagnostics::{Diagnostic, has_errors};
-use supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
-use supervisor_gen::validate::{ValidateOptions, validate};
-use supervisor_gen::xml_read::read_model;
+use swarm_runtime::supervisor_gen::architecture::Architecture;
+use swarm_runtime::supervisor_gen::compiled::{CodegenError, CompiledFormatError, SupervisorSet};
+use swarm_runtime::supervisor_gen::convert::{ConvertError, to_project};
+use swarm_runtime::supervisor_gen::diagnostics::{Diagnostic, has_errors};
+use swarm_runtime::supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
+use swarm_runtime::supervisor_gen::validate::{ValidateOptions, validate};
+use swarm_runtime::supervisor_gen::xml_read::read_model;
 use thiserror::Error;
 use tracing::warn;
 

@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 
 use robot_agent::params::Params;
 use robot_agent::profiles::bind_profile;
-use supervisor_gen::architecture::Architecture;
-use supervisor_gen::load::{Input, load};
-use supervisor_gen::pipeline::{Synthesis, SynthesisOptions, synthesize};
-use supervisor_gen::validate::ValidateOptions;
+use swarm_runtime::supervisor_gen::architecture::Architecture;
+use swarm_runtime::supervisor_gen::load::{Input, load};
+use swarm_runtime::supervisor_gen::pipeline::{Synthesis, SynthesisOptions, synthesize};
+use swarm_runtime::supervisor_gen::validate::ValidateOptions;
 
 fn models(variant: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -28,7 +28,8 @@ fn synthesise(variant: &str, files: &[&str]) -> Synthesis {
         .map(ToString::to_string)
         .collect();
     assert!(errors.is_empty(), "{errors:#?}");
-    let project = supervisor_gen::convert::to_project(&validation.models.unwrap()).unwrap();
+    let project =
+        swarm_runtime::supervisor_gen::convert::to_project(&validation.models.unwrap()).unwrap();
     synthesize(
         &project,
         Architecture::LocalModular,
@@ -199,13 +200,15 @@ fn sct_walk_supervisor_grows_to_six_states_and_memcons_189_bytes() {
 #[test]
 fn compiled_file_written_by_the_toolchain_loads_as_the_same_set_as_the_model_folder() {
     let m = |f: &str| models("ptsct").join(f);
-    let built = supervisor_gen::build::build(&supervisor_gen::build::BuildRequest {
-        plants: vec![m("G_prox.xml"), m("G_motor.xml")],
-        specs: vec![m("E_walk.xml"), m("E_avoid.xml")],
-        architecture: Architecture::LocalModular,
-        raw_weights: false,
-        thesis_literal_probabilities: false,
-    })
+    let built = swarm_runtime::supervisor_gen::build::build(
+        &swarm_runtime::supervisor_gen::build::BuildRequest {
+            plants: vec![m("G_prox.xml"), m("G_motor.xml")],
+            specs: vec![m("E_walk.xml"), m("E_avoid.xml")],
+            architecture: Architecture::LocalModular,
+            raw_weights: false,
+            thesis_literal_probabilities: false,
+        },
+    )
     .unwrap();
     let dir = tempfile::tempdir().unwrap();
     let compiled = dir.path().join("supervisors.ptsct");

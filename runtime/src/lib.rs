@@ -10,3 +10,7 @@ pub mod launcher;
 pub mod messages;
 pub mod player;
 pub mod transport;
+
+/// The ptSCT toolchain's formats (compiled supervisor sets, models, synthesis), re-exported so that agents reach
+/// them through the runtime contract only.
+pub use supervisor_gen;

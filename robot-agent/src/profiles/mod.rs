@@ -5,9 +5,9 @@
 pub mod obstacle_avoidance;
 pub mod timer;
 
-use supervisor_gen::compiled::CompiledEvent;
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_runtime::player::EventCallbacks;
+use swarm_runtime::supervisor_gen::compiled::CompiledEvent;
 use thiserror::Error;
 
 use crate::binding::{BindError, bind};

@@ -81,6 +81,10 @@ pub struct RunReport {
     pub interrupted: bool,
     /// Robots whose agent died during the run, with the tick the world had completed at the time.
     pub deaths: Vec<Death>,
+    /// Process id of the world.
+    pub world_pid: u32,
+    /// Process id of each robot's (first) agent, by robot index.
+    pub agent_pids: Vec<u32>,
 }
 
 /// An agent that died while the run went on.
@@ -231,17 +235,19 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .stdout(Stdio::piped()),
     )
     .map_err(io(format!("starting {}", binaries.world.display())))?;
+    let world_pid = world.id();
     let world_stdin = world.stdin.take();
     let reports = follow_reports(world.stdout.take());
     children.world = Some(world);
 
     wait_ready(&mut children, &reports, robots)?;
     children.agents.reserve(roster.len());
-    for robot in 0..roster.len() {
+    for (robot, entry) in roster.iter().enumerate() {
         let agent_args = AgentArgs {
             run: run_args.clone(),
             robot: robot as u32,
             config: config.clone(),
+            controller: entry.epuck.controller.clone(),
             seed,
             robots: options.robots,
         };
@@ -259,6 +265,12 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         children.agents.push(Some(child));
     }
 
+    let agent_pids: Vec<u32> = children
+        .agents
+        .iter()
+        .flatten()
+        .map(std::process::Child::id)
+        .collect();
     let progress = progress_bar(options.progress, ticks, robots);
     let mut supervision = Supervision {
         children,
@@ -287,6 +299,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .map_or(0.0, |t| t.duration_since(started).as_secs_f64()),
         interrupted: supervision.interrupted,
         deaths: supervision.deaths.clone(),
+        world_pid,
+        agent_pids,
     };
     complete_summary(&out_dir, &report)?;
     Ok(report)
@@ -317,6 +331,7 @@ fn check_controllers(
             run: run_args.clone(),
             robot: robot.index,
             config: config.to_path_buf(),
+            controller: controller.clone(),
             seed,
             robots,
         };
@@ -464,10 +479,7 @@ impl Supervision {
                 Ok(WorldReport::Tick { tick, dead, .. }) => {
                     if self.first_tick.is_none() {
                         self.first_tick = Some(Instant::now());
-                        tracing::debug!(
-                            after = ?self.started.elapsed(),
-                            "first tick"
-                        );
+                        tracing::info!(after = ?self.started.elapsed(), "first tick completed");
                     }
                     self.last_tick = tick;
                     self.progress.set_position(tick);
@@ -585,6 +597,10 @@ fn complete_summary(out_dir: &Path, report: &RunReport) -> Result<(), LaunchErro
         );
         object.insert("interrupted".into(), report.interrupted.into());
         object.insert("deaths".into(), deaths.into());
+        object.insert(
+            "processes".into(),
+            serde_json::json!({"world": report.world_pid, "agents": report.agent_pids}),
+        );
     }
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     std::fs::write(&path, text + "\n").map_err(io(format!("writing {}", path.display())))

@@ -16,7 +16,7 @@ pub struct RunArgs {
     #[arg(long = "run")]
     pub run: String,
     /// Absolute iceoryx2 root directory of the run.
-    #[arg(long = "root")]
+    #[arg(long = "iox-root")]
     pub iox_root: PathBuf,
 }
 
@@ -26,7 +26,7 @@ impl RunArgs {
         vec![
             "--run".into(),
             self.run.clone(),
-            "--root".into(),
+            "--iox-root".into(),
             self.iox_root.display().to_string(),
         ]
     }
@@ -96,9 +96,12 @@ pub struct AgentArgs {
     /// Index of the robot in the run (0..N).
     #[arg(long)]
     pub robot: u32,
-    /// The experiment configuration; the robot runs the controller its `<e-puck>` names.
+    /// The experiment configuration (the controller's parameters and supervisors come from it).
     #[arg(long)]
     pub config: PathBuf,
+    /// Id of the robot's controller in the configuration's `<controllers>`.
+    #[arg(long)]
+    pub controller: String,
     /// Run seed; the robot's random stream is derived from it and the robot index.
     #[arg(long)]
     pub seed: u64,
@@ -116,6 +119,8 @@ impl AgentArgs {
             self.robot.to_string(),
             "--config".into(),
             self.config.display().to_string(),
+            "--controller".into(),
+            self.controller.clone(),
             "--seed".into(),
             self.seed.to_string(),
         ]);
@@ -173,6 +178,7 @@ mod tests {
             run: run(),
             robot: 7,
             config: PathBuf::from("configs/x.argos"),
+            controller: "fdc".into(),
             seed: 124,
             robots: Some(40),
         };

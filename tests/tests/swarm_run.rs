@@ -1,0 +1,292 @@
+//! `swarm run` end to end: a real world process, one real agent process per robot, real iceoryx2 shared memory
+//! and real files. Every test also checks that its run left no process and no shared-memory file behind.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+use swarm_system_tests::{
+    SwarmOutcome, assert_clean, bin_dir, process_leftovers, shm_leftovers, swarm, workspace_file,
+    workspace_root,
+};
+
+const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
+
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("a temporary directory")
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json exists");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+fn run_ok(config: &str, out: &Path, extra: &[&str]) -> SwarmOutcome {
+    let out_arg = out.display().to_string();
+    let mut args = vec!["run", config, "--out", out_arg.as_str(), "--no-progress"];
+    args.extend_from_slice(extra);
+    let outcome = swarm(&args);
+    assert!(
+        outcome.output.status.success(),
+        "swarm run {config} failed:\n{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+    outcome
+}
+
+#[test]
+fn forty_robot_run_completes_with_one_process_per_robot() {
+    let out = temp_dir();
+    let outcome = run_ok(OBSTACLE_AVOIDANCE, out.path(), &["--ticks", "40"]);
+    let summary = summary(out.path());
+    assert_eq!(summary["robots"], 40);
+    assert_eq!(summary["ticks"], 40);
+    let agents: Vec<u64> = summary["processes"]["agents"]
+        .as_array()
+        .expect("agent pids are listed")
+        .iter()
+        .filter_map(serde_json::Value::as_u64)
+        .collect();
+    let world = summary["processes"]["world"]
+        .as_u64()
+        .expect("the world pid is listed");
+    let mut distinct = agents.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert_eq!(
+        distinct.len(),
+        40,
+        "every robot had its own process: {agents:?}"
+    );
+    assert!(
+        !agents.contains(&world),
+        "no robot ran inside the world process"
+    );
+    assert!(
+        !agents.contains(&u64::from(outcome.pid)),
+        "no robot ran inside the launcher"
+    );
+    let trajectory =
+        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    assert_eq!(
+        trajectory.lines().count(),
+        1 + 41 * 40,
+        "a header, then 40 robots at ticks 0..=40"
+    );
+    let events = std::fs::read_to_string(out.path().join("events.csv")).expect("events.csv");
+    assert!(events.lines().skip(1).all(|l| l.split(',').count() == 4));
+    assert!(
+        events.contains(",Go\n") && events.contains(",saw-obs\n"),
+        "events are recorded by name"
+    );
+}
+
+#[test]
+fn same_seed_gives_identical_trajectory_and_events() {
+    let records = |seed: &str| {
+        let out = temp_dir();
+        run_ok(
+            OBSTACLE_AVOIDANCE,
+            out.path(),
+            &["--ticks", "60", "--seed", seed],
+        );
+        let read = |name: &str| std::fs::read(out.path().join(name)).expect("record exists");
+        (read("trajectory.csv"), read("events.csv"))
+    };
+    let first = records("7");
+    let second = records("7");
+    assert!(
+        first.0 == second.0,
+        "trajectory.csv differs between two runs with seed 7"
+    );
+    assert!(
+        first.1 == second.1,
+        "events.csv differs between two runs with seed 7"
+    );
+    let other = records("8");
+    assert!(
+        first.0 != other.0,
+        "seed 8 should place and drive the robots differently"
+    );
+}
+
+#[test]
+fn thesis_and_argos_example_configurations_run_unchanged() {
+    for config in [
+        "configs/obstacle_avoidance/thesis_example.argos",
+        "configs/argos_examples/epuck_obstacleavoidance.argos",
+    ] {
+        let out = temp_dir();
+        run_ok(config, out.path(), &["--ticks", "10"]);
+        let summary = summary(out.path());
+        assert_eq!(summary["ticks"], 10, "{config}");
+        assert!(summary["robots"].as_u64().unwrap_or(0) > 0, "{config}");
+    }
+}
+
+/// A copy of the main experiment with other controller params; supervisor paths in `params` are absolute.
+fn experiment_with_params(dir: &Path, params: &str) -> String {
+    let text =
+        std::fs::read_to_string(workspace_file(OBSTACLE_AVOIDANCE)).expect("the main experiment");
+    let original =
+        r#"<params profile="obstacle_avoidance" supervisors="models/ptsct" velocity="12.8" />"#;
+    assert!(
+        text.contains(original),
+        "the main experiment's params changed; update this test"
+    );
+    let path = dir.join("experiment.argos");
+    std::fs::write(&path, text.replace(original, params)).expect("write the experiment");
+    path.display().to_string()
+}
+
+fn assert_fails_before_first_tick(config: &str, out: &Path, expected: &[&str]) {
+    let out_arg = out.display().to_string();
+    let outcome = swarm(&[
+        "run",
+        config,
+        "--out",
+        &out_arg,
+        "--no-progress",
+        "--ticks",
+        "5",
+    ]);
+    assert!(!outcome.output.status.success(), "the run should fail");
+    let stderr = outcome.stderr();
+    for needle in expected {
+        assert!(
+            stderr.contains(needle),
+            "stderr should mention {needle:?}:\n{stderr}"
+        );
+    }
+    assert!(!out.join("trajectory.csv").exists(), "no tick may run");
+    assert_clean(&outcome);
+}
+
+#[test]
+fn agent_with_unbound_events_fails_before_the_first_tick() {
+    let dir = temp_dir();
+    let sct_models = workspace_file("configs/obstacle_avoidance/models/sct");
+    let config = experiment_with_params(
+        dir.path(),
+        &format!(
+            r#"<params profile="obstacle_avoidance" supervisors="{}" />"#,
+            sct_models.display()
+        ),
+    );
+    assert_fails_before_first_tick(
+        &config,
+        &dir.path().join("out"),
+        &["robot 0 (fb0) failed to start", "timer_1"],
+    );
+}
+
+#[test]
+fn agent_with_a_corrupt_supervisor_file_fails_before_the_first_tick() {
+    let dir = temp_dir();
+    let corrupt = dir.path().join("corrupt.ptsct");
+    std::fs::write(&corrupt, b"PTSC\x00\x01 this is not a supervisor set").expect("write the file");
+    let config = experiment_with_params(
+        dir.path(),
+        &format!(
+            r#"<params profile="obstacle_avoidance" supervisors="{}" />"#,
+            corrupt.display()
+        ),
+    );
+    assert_fails_before_first_tick(
+        &config,
+        &dir.path().join("out"),
+        &["failed to start", "corrupt.ptsct"],
+    );
+}
+
+#[test]
+fn invalid_configuration_is_reported_with_its_location() {
+    let dir = temp_dir();
+    let text =
+        std::fs::read_to_string(workspace_file(OBSTACLE_AVOIDANCE)).expect("the main experiment");
+    let path = dir.path().join("typo.argos");
+    std::fs::write(&path, text.replace("<epuck_proximity ", "<epuck_prox "))
+        .expect("write the experiment");
+    let config = path.display().to_string();
+    let expected = format!("{config}:18:9: unknown sensor 'epuck_prox'");
+    assert_fails_before_first_tick(
+        &config,
+        &dir.path().join("out"),
+        &[&expected, "epuck_proximity"],
+    );
+}
+
+#[test]
+fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
+    let out = temp_dir();
+    let dir = bin_dir();
+    let mut child = Command::new(dir.join("swarm"))
+        .args([
+            "run",
+            "configs/obstacle_avoidance/thesis_example.argos",
+            "--no-progress",
+            "--out",
+        ])
+        .arg(out.path())
+        .env("SWARM_BIN_DIR", dir)
+        .env("RUST_LOG", "info")
+        .current_dir(workspace_root())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("swarm starts");
+    let pid = child.id();
+    let prefix = format!("sw{pid:x}-");
+    let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
+    let mut seen = String::new();
+    let mut line = String::new();
+    while stderr
+        .read_line(&mut line)
+        .expect("read the launcher's log")
+        > 0
+    {
+        seen.push_str(&line);
+        if line.contains("first tick completed") {
+            break;
+        }
+        line.clear();
+    }
+    assert!(
+        seen.contains("first tick completed"),
+        "the run never ticked:\n{seen}"
+    );
+    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
+    let mut rest = String::new();
+    while stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
+    let status = child.wait().expect("the launcher exits");
+    assert!(
+        status.success(),
+        "an interrupted run ends cleanly:\n{seen}{rest}"
+    );
+    let summary = summary(out.path());
+    assert_eq!(summary["interrupted"], true);
+    let ticks = summary["ticks"].as_u64().expect("ticks are counted");
+    assert!(ticks >= 1);
+    let trajectory =
+        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let last_tick: u64 = trajectory
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .expect("the last row starts with its tick");
+    assert_eq!(
+        last_tick, ticks,
+        "every completed tick is in the trajectory, and nothing more"
+    );
+    assert_eq!(
+        trajectory.lines().count() as u64,
+        1 + (ticks + 1) * 40,
+        "no partial tick"
+    );
+    assert_eq!(process_leftovers(&prefix), Vec::<u32>::new());
+    assert!(shm_leftovers(&prefix).is_empty());
+}
