@@ -62,7 +62,7 @@ fn density_world(n: usize) -> World {
             &format!("fb{i}"),
             "fdc",
             r.position,
-            r.angle,
+            r.angle(),
             Devices::PROXIMITY_ONLY,
         );
     }
