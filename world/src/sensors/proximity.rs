@@ -68,7 +68,7 @@ pub fn sense(
     scratch.retain(|&i| {
         i != me && scene.shapes[i as usize].signed_distance(position) <= PROXIMITY_REACH
     });
-    let (c, s) = heading.sin_cos();
+    let (s, c) = heading.sin_cos();
     for (value, local) in out
         .iter_mut()
         .zip(sensor_directions(options.argos_uniform_ring))
