@@ -141,8 +141,7 @@ pub fn carry(arena: &mut Arena) {
         if let TargetState::Carried(robot) = t.state
             && let Some(r) = arena.robots.get(robot.index())
         {
-            t.placed.position = r.position;
-            t.placed.angle = r.heading;
+            t.placed.set_pose(r.position, r.heading);
         }
     }
 }

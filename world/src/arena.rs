@@ -93,9 +93,9 @@ impl Arena {
             r.carrying = None;
         }
         t.state = TargetState::InArena;
-        t.placed.position = position;
+        t.placed.set_pose(position, t.placed.angle());
         self.physics
-            .teleport(t.handles.body, position, t.placed.angle);
+            .teleport(t.handles.body, position, t.placed.angle());
         self.physics.set_enabled(t.handles, true);
     }
 

@@ -75,8 +75,9 @@ pub struct Placed {
     pub shape: Shape,
     /// Position of the body origin.
     pub position: Vec2,
-    /// Heading in radians.
-    pub angle: f32,
+    angle: f32,
+    /// (cos, sin) of `angle`, computed once per pose: sensors test many rays against the same body.
+    rot: Vec2,
 }
 
 impl Placed {
@@ -86,17 +87,36 @@ impl Placed {
             shape,
             position,
             angle,
+            rot: unit(angle),
         }
     }
 
+    /// Heading in radians.
+    pub fn angle(&self) -> f32 {
+        self.angle
+    }
+
+    /// Moves the shape to a new pose.
+    pub fn set_pose(&mut self, position: Vec2, angle: f32) {
+        self.position = position;
+        if angle != self.angle {
+            self.angle = angle;
+            self.rot = unit(angle);
+        }
+    }
+
+    /// A point of the body's own frame in the arena frame.
+    pub fn to_world(&self, local: Vec2) -> Vec2 {
+        let (c, s) = (self.rot.x, self.rot.y);
+        self.position + Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y)
+    }
+
     fn local_point(&self, p: Vec2) -> Vec2 {
-        let (s, c) = self.angle.sin_cos();
-        let d = p - self.position;
-        Vec2::new(c * d.x + s * d.y, -s * d.x + c * d.y)
+        self.dir_to_local(p - self.position)
     }
 
     fn dir_to_local(&self, v: Vec2) -> Vec2 {
-        let (s, c) = self.angle.sin_cos();
+        let (c, s) = (self.rot.x, self.rot.y);
         Vec2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
     }
 
@@ -105,7 +125,7 @@ impl Placed {
         match self.shape {
             Shape::Disc { radius } => Aabb::around(self.position, radius),
             Shape::Rect { half } => {
-                let (s, c) = self.angle.sin_cos();
+                let (c, s) = (self.rot.x, self.rot.y);
                 let ext = Vec2::new(
                     c.abs() * half.x + s.abs() * half.y,
                     s.abs() * half.x + c.abs() * half.y,
@@ -202,12 +222,7 @@ fn ray_rect(o: Vec2, dir: Vec2, half: Vec2) -> Option<f32> {
 
 /// Separating-axis test for two oriented rectangles.
 fn rects_overlap(a: &Placed, ha: Vec2, b: &Placed, hb: Vec2) -> bool {
-    let axes = [
-        unit(a.angle),
-        unit(a.angle + std::f32::consts::FRAC_PI_2),
-        unit(b.angle),
-        unit(b.angle + std::f32::consts::FRAC_PI_2),
-    ];
+    let axes = [a.rot, a.rot.perp(), b.rot, b.rot.perp()];
     let (ax, ay) = (axes[0], axes[1]);
     let (bx, by) = (axes[2], axes[3]);
     let d = b.position - a.position;

@@ -4,6 +4,8 @@
 //! actuators, LED / range-and-bearing / pheromone media, loop functions for task metrics, and the recorder.
 //! It implements the control interface defined in `swarm_runtime::messages`; it never depends on robot-agent.
 
+#![warn(missing_docs)]
+
 pub mod actuators;
 pub mod arena;
 pub mod devices;

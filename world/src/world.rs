@@ -126,7 +126,7 @@ impl WorldBuilder {
         let handles = self.arena.physics.add(
             placed.shape,
             placed.position,
-            placed.angle,
+            placed.angle(),
             motion,
             tag,
             false,
@@ -155,7 +155,7 @@ impl WorldBuilder {
         let handles = self.arena.physics.add(
             placed.shape,
             placed.position,
-            placed.angle,
+            placed.angle(),
             Motion::Fixed,
             tag,
             false,
@@ -421,7 +421,8 @@ impl World {
             .iter_mut()
             .filter(|o| matches!(o.motion, Motion::Movable { .. }))
         {
-            (o.placed.position, o.placed.angle) = arena.physics.pose(o.handles.body);
+            let (position, angle) = arena.physics.pose(o.handles.body);
+            o.placed.set_pose(position, angle);
         }
         actuators::carry(arena);
     }

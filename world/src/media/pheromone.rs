@@ -23,6 +23,8 @@ pub struct PheromoneField {
     nx: usize,
     ny: usize,
     rates: [ChannelRates; PHEROMONE_CHANNELS],
+    /// Whether anything was ever deposited in each channel; untouched channels are all zero and are not stepped.
+    touched: [bool; PHEROMONE_CHANNELS],
     values: Vec<f32>,
     scratch: Vec<f32>,
 }
@@ -40,6 +42,7 @@ impl PheromoneField {
             nx,
             ny,
             rates,
+            touched: [false; PHEROMONE_CHANNELS],
             values: vec![0.0; n],
             scratch: vec![0.0; n],
         }
@@ -77,6 +80,7 @@ impl PheromoneField {
             return;
         }
         let (x, y) = self.cell_of(p);
+        self.touched[channel] = true;
         let v = &mut self.values[(channel * self.ny + y) * self.nx + x];
         *v = (*v + amount).max(0.0);
     }
@@ -114,6 +118,9 @@ impl PheromoneField {
     pub fn step(&mut self) {
         let (nx, ny) = (self.nx, self.ny);
         for (ch, rates) in self.rates.iter().enumerate() {
+            if !self.touched[ch] || (rates.evaporation == 0.0 && rates.diffusion == 0.0) {
+                continue;
+            }
             let base = ch * nx * ny;
             let keep = (1.0 - rates.evaporation).clamp(0.0, 1.0);
             if rates.diffusion > 0.0 {

@@ -123,11 +123,8 @@ fn fill_placed(pixmap: &mut Pixmap, placed: &Placed, paint: &Paint, tf: Transfor
             PathBuilder::from_circle(placed.position.x, placed.position.y, radius)
         }
         Shape::Rect { half } => {
-            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
-                let (s, c) = placed.angle.sin_cos();
-                let local = Vec2::new(sx * half.x, sy * half.y);
-                placed.position + Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y)
-            });
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(sx, sy)| placed.to_world(Vec2::new(sx * half.x, sy * half.y)));
             let mut pb = PathBuilder::new();
             pb.move_to(corners[0].x, corners[0].y);
             for p in &corners[1..] {

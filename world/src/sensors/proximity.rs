@@ -9,7 +9,9 @@ use swarm_runtime::messages::PROXIMITY_SENSORS;
 
 use crate::devices::ProximityOptions;
 use crate::entities::ROBOT_RADIUS;
-use crate::geometry::{Aabb, unit};
+use std::sync::LazyLock;
+
+use crate::geometry::{Aabb, Vec2, unit};
 use crate::scene::{PROXIMITY_REACH, Scene};
 use crate::sensors::Observer;
 use crate::sensors::noise;
@@ -28,6 +30,14 @@ pub fn sensor_angle(i: usize, argos_uniform_ring: bool) -> f32 {
     } else {
         PHYSICAL_ANGLES_DEG[i].to_radians()
     }
+}
+
+/// Unit vectors of the sensor directions in the robot frame, for both layouts (computed once).
+fn sensor_directions(argos_uniform_ring: bool) -> &'static [Vec2; PROXIMITY_SENSORS] {
+    static TABLES: LazyLock<[[Vec2; PROXIMITY_SENSORS]; 2]> = LazyLock::new(|| {
+        [false, true].map(|ring| std::array::from_fn(|i| unit(sensor_angle(i, ring))))
+    });
+    &TABLES[usize::from(argos_uniform_ring)]
 }
 
 /// The IRIDIA calibration: the reading for an object `d` metres from the ray start,
@@ -58,8 +68,12 @@ pub fn sense(
     scratch.retain(|&i| {
         i != me && scene.shapes[i as usize].signed_distance(position) <= PROXIMITY_REACH
     });
-    for (i, value) in out.iter_mut().enumerate() {
-        let dir = unit(heading + sensor_angle(i, options.argos_uniform_ring));
+    let (s, c) = heading.sin_cos();
+    for (value, local) in out
+        .iter_mut()
+        .zip(sensor_directions(options.argos_uniform_ring))
+    {
+        let dir = Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y);
         let origin = position + dir * ROBOT_RADIUS;
         let nearest = scratch
             .iter()
