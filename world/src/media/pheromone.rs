@@ -87,6 +87,9 @@ impl PheromoneField {
 
     /// Concentration of `channel` in the cell under `p`.
     pub fn concentration(&self, channel: usize, p: Vec2) -> f32 {
+        if !self.touched.get(channel).copied().unwrap_or(false) {
+            return 0.0;
+        }
         let (x, y) = self.cell_of(p);
         self.cell_value(channel, x, y)
     }
@@ -94,7 +97,7 @@ impl PheromoneField {
     /// Gradient (d/dx, d/dy) of `channel` at `p` in the arena frame, by central differences between the
     /// neighbouring cells (one-sided at the border).
     pub fn gradient(&self, channel: usize, p: Vec2) -> Vec2 {
-        if channel >= PHEROMONE_CHANNELS {
+        if !self.touched.get(channel).copied().unwrap_or(false) {
             return Vec2::ZERO;
         }
         let (x, y) = self.cell_of(p);
