@@ -213,13 +213,14 @@ fn density_configs_keep_argos_density_of_50_robots_per_16_square_metres() {
         );
         let c = exp.controller("oa").expect("controller oa");
         assert_eq!(c.params.get("profile"), Some("obstacle_avoidance"));
+        assert_eq!(c.params.get("supervisors"), Some("models/ptsct"));
         assert_eq!(
-            c.params.get("supervisors"),
-            Some("models/obstacle_avoidance.xml")
+            exp.resolve("models/ptsct"),
+            repo("configs/obstacle_avoidance/models/ptsct")
         );
-        assert_eq!(
-            exp.resolve("models/obstacle_avoidance.xml"),
-            repo("configs/obstacle_avoidance/models/obstacle_avoidance.xml")
+        assert!(
+            exp.resolve("models/ptsct").is_dir(),
+            "the ptSCT models ship with the configs"
         );
     }
 }

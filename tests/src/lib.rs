@@ -9,8 +9,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-/// The folder holding `swarm`, `swarm-world` and `robot-agent`, built once per test binary with the cargo that
-/// runs the tests (debug profile, like the tests themselves).
+/// The folder holding `swarm`, `swarm-world` and `robot-agent`, brought up to date once per test binary with the
+/// cargo that runs the tests. `--workspace --tests` selects the same packages and features as
+/// `cargo test --workspace`, which has already built these programs, so under the README's test command this is
+/// a no-op; run alone (`cargo test -p swarm-system-tests`) it builds what is missing.
 pub fn bin_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
