@@ -508,8 +508,8 @@ impl Supervision {
         }
     }
 
-    /// Reaps exited agents: before the first tick an exit is a failed start; afterwards it is a death the world
-    /// hears of at once.
+    /// Reaps exited agents: before the first tick an exit is a failed start; afterwards an unsuccessful exit is a
+    /// death the world hears of at once (a successful one means the world already ended the run).
     fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
         for (robot, status) in self.children.reap_agents() {
             if self.first_tick.is_none() {
@@ -525,6 +525,10 @@ impl Supervision {
                     status: exit_status(status),
                     log,
                 });
+            }
+            if status.success() {
+                // Agents exit 0 only when the world has ended the run; the `finished` report may still be queued.
+                continue;
             }
             tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
             if let Some(stdin) = self.world_stdin.as_mut() {
