@@ -18,15 +18,7 @@ pub fn bin_dir() -> &'static Path {
     DIR.get_or_init(|| {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let status = Command::new(cargo)
-            .args(["build", "--quiet", "--bins"])
-            .args([
-                "-p",
-                "swarm-runtime",
-                "-p",
-                "swarm-world",
-                "-p",
-                "robot-agent",
-            ])
+            .args(["build", "--quiet", "--workspace", "--tests"])
             .current_dir(workspace_root())
             .status()
             .expect("cargo must be runnable from the tests");
