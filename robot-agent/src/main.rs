@@ -147,13 +147,7 @@ fn run(args: &Args) -> Result<()> {
 }
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info,supervisor_gen=warn")),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    swarm_runtime::logging::init("info,supervisor_gen=warn");
     match run(&Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

@@ -7,6 +7,7 @@
 
 pub mod config;
 pub mod launcher;
+pub mod logging;
 pub mod messages;
 pub mod player;
 pub mod transport;
