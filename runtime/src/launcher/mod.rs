@@ -18,7 +18,7 @@ pub mod world_report;
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{ChildStdin, Command, ExitStatus, Stdio};
+use std::process::{ChildStdin, Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
@@ -347,7 +347,7 @@ fn check_controllers(
             return Err(LaunchError::AgentFailed {
                 robot: robot.index,
                 id: robot.id.clone(),
-                status: exit_status(output.status),
+                status: output.status.to_string(),
                 log: lines[lines.len().saturating_sub(LOG_LINES_QUOTED)..].join("\n"),
             });
         }
@@ -385,10 +385,6 @@ fn follow_reports(stdout: Option<std::process::ChildStdout>) -> Receiver<WorldRe
     receiver
 }
 
-fn exit_status(status: ExitStatus) -> String {
-    status.to_string()
-}
-
 /// Waits for the world's `ready`, failing early if it dies.
 fn wait_ready(
     children: &mut Children,
@@ -405,15 +401,15 @@ fn wait_ready(
                     when: format!("while the launcher expected {robots}"),
                 });
             }
-            Ok(_) | Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => {}
+            // A closed channel means the world is exiting; its status below says how.
+            Ok(_) | Err(_) => {}
         }
         if let Some(world) = children.world.as_mut()
             && let Ok(Some(status)) = world.try_wait()
         {
             children.world = None;
             return Err(LaunchError::WorldDied {
-                status: exit_status(status),
+                status: status.to_string(),
                 when: "before it was ready (its error is above)".into(),
             });
         }
@@ -522,7 +518,7 @@ impl Supervision {
                         .get(robot as usize)
                         .cloned()
                         .unwrap_or_default(),
-                    status: exit_status(status),
+                    status: status.to_string(),
                     log,
                 });
             }
@@ -537,7 +533,7 @@ impl Supervision {
             self.deaths.push(Death {
                 robot,
                 after_tick: self.last_tick,
-                status: exit_status(status),
+                status: status.to_string(),
             });
         }
         Ok(())
@@ -553,7 +549,7 @@ impl Supervision {
             Ok(())
         } else {
             Err(LaunchError::WorldDied {
-                status: exit_status(status),
+                status: status.to_string(),
                 when: format!("after tick {}", self.last_tick),
             })
         }

@@ -263,13 +263,8 @@ fn led_group(ctx: &mut Ctx, parent: &Element) -> Option<Option<LedGroup>> {
         format!("<leds> of <{}>", parent.name),
     );
     let mut leds = Vec::new();
-    let mut ok = true;
-    for child in &el.children {
-        if child.name != "led" {
-            ctx.unknown_element(child, &el.name, &["led"]);
-            ok = false;
-            continue;
-        }
+    let (children, mut ok) = ctx.children_named(el, "led");
+    for child in children {
         ctx.unknown_attributes(child, &["offset", "anchor", "color"]);
         let offset: Option<Vec3> = ctx.required(child, "offset");
         let anchor: String = ctx
@@ -527,13 +522,8 @@ fn regions(ctx: &mut Ctx, el: &Element) -> Option<FloorSource> {
         }),
     );
     let mut regions = Vec::new();
-    let mut ok = true;
-    for child in &el.children {
-        if child.name != "region" {
-            ctx.unknown_element(child, &el.name, &["region"]);
-            ok = false;
-            continue;
-        }
+    let (children, mut ok) = ctx.children_named(el, "region");
+    for child in children {
         ctx.unknown_attributes(child, &["min", "max", "color"]);
         let min = ctx.required(child, "min");
         let max = ctx.required(child, "max");

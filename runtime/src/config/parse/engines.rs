@@ -175,13 +175,8 @@ fn pheromone(ctx: &mut Ctx, el: &Element) -> Option<PheromoneField> {
     let id: Option<String> = ctx.required(el, "id");
     let cell_size = ctx.positive(el, "cell_size");
     let mut channels: Vec<PheromoneChannel> = Vec::new();
-    let mut ok = true;
-    for child in &el.children {
-        if child.name != "channel" {
-            ctx.unknown_element(child, &el.name, &["channel"]);
-            ok = false;
-            continue;
-        }
+    let (children, mut ok) = ctx.children_named(el, "channel");
+    for child in children {
         let Some(channel) = channel(ctx, child) else {
             ok = false;
             continue;

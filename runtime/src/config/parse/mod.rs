@@ -171,6 +171,26 @@ impl Ctx {
         );
     }
 
+    /// The children of `parent` named `name`, in file order; every other child is reported with
+    /// [`Ctx::unknown_element`]. The flag is `false` when any was.
+    pub(crate) fn children_named<'a>(
+        &mut self,
+        parent: &'a Element,
+        name: &str,
+    ) -> (Vec<&'a Element>, bool) {
+        let mut all_known = true;
+        let mut named = Vec::new();
+        for child in &parent.children {
+            if child.name == name {
+                named.push(child);
+            } else {
+                self.unknown_element(child, &parent.name, &[name]);
+                all_known = false;
+            }
+        }
+        (named, all_known)
+    }
+
     /// Reports a second occurrence of an element that may appear once.
     pub(crate) fn duplicate(&mut self, child: &Element, parent: &str, first: Location) {
         self.error(
