@@ -1,50 +1,53 @@
-//! An agent's side of the lockstep: join a run for one robot, sleep until the world publishes a tick, read the
-//! robot's own frame in place, answer with a command.
+//! An agent's side of the lockstep: join a run for one robot, sleep until the world opens a tick, load the
+//! robot's own frame from the frame board, answer by writing the command board of its robot.
 //!
-//! It must never answer for another robot (its command service is its robot's alone) and never answer a tick
-//! the world has not opened yet.
+//! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
+//! never answer a tick the world has not opened yet, nor the same tick twice.
+
+use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::publisher::PublisherCreateError;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::subscriber::SubscriberCreateError;
+use iceoryx2::port::reader::{EntryHandle, Reader};
+use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
 use iceoryx2::prelude::ipc;
-use iceoryx2::sample::Sample;
 
 use super::TransportError;
 use super::run::RunSpec;
-use super::services::{self, CommandService, FrameService};
+use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
+/// How long a joining agent waits for the world to replace its robot's command board after a death.
+const BOARD_WAIT: Duration = Duration::from_secs(30);
 /// Default number of polls of the tick word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
-/// One tick's frame of this agent's robot, read in place from the world's shared-memory sample.
+/// One tick's frame of this agent's robot, loaded from the world's frame board.
 pub struct TickFrame {
-    sample: Sample<ipc::Service, [SensorFrame], ()>,
-    index: usize,
+    frame: SensorFrame,
 }
 
 impl TickFrame {
     /// The robot's frame.
     pub fn frame(&self) -> &SensorFrame {
-        &self.sample.payload()[self.index]
+        &self.frame
     }
 
     /// The tick of the frame.
     pub fn tick(&self) -> u64 {
-        self.frame().tick
+        self.frame.tick
     }
 }
 
-/// The iceoryx2 side of an agent: its node, and its ports on the frame service and its robot's command service.
+/// The iceoryx2 side of an agent: its node, its robot's entry of the frame board and its command board entry.
+/// Entry handles keep their ports and services alive; the fields are only held, in drop order.
 struct Ports {
-    frame_subscriber: Subscriber<ipc::Service, [SensorFrame], ()>,
-    command_publisher: Publisher<ipc::Service, ActuatorCommand, ()>,
-    _command_service: CommandService,
-    _frame_service: FrameService,
+    frame_entry: EntryHandle<ipc::Service, u32, SensorFrame>,
+    command_entry: EntryHandleMut<ipc::Service, u32, ActuatorCommand>,
+    _frame_reader: Reader<ipc::Service, u32>,
+    _command_writer: Writer<ipc::Service, u32>,
+    _command_board: Board,
+    _frame_board: Board,
     _node: Node<ipc::Service>,
 }
 
@@ -53,7 +56,8 @@ pub struct AgentLink {
     robot: u32,
     spin: u32,
     seen_epoch: u32,
-    pending: Option<Sample<ipc::Service, [SensorFrame], ()>>,
+    /// The last tick handed out by [`AgentLink::next_tick`] (0: none yet).
+    last_tick: u64,
     ports: Ports,
     sync: SyncBlock,
 }
@@ -70,15 +74,17 @@ impl AgentLink {
         if let JoinClaim::Taken = sync.claim_robot(robot) {
             return Err(TransportError::RobotTaken { robot });
         }
-        match Self::connect(run, robot, capacity) {
+        match Self::connect(run, robot, &sync) {
             Ok(ports) => {
                 let seen_epoch = sync.epoch();
+                // A replacement agent must not answer a tick its predecessor already answered.
+                let last_tick = sync.tick();
                 sync.announce_ready(robot);
                 Ok(AgentLink {
                     robot,
                     spin: DEFAULT_AGENT_SPIN,
                     seen_epoch,
-                    pending: None,
+                    last_tick,
                     ports,
                     sync,
                 })
@@ -90,48 +96,48 @@ impl AgentLink {
         }
     }
 
-    fn connect(run: &RunSpec, robot: u32, capacity: u32) -> Result<Ports, TransportError> {
+    fn connect(run: &RunSpec, robot: u32, sync: &SyncBlock) -> Result<Ports, TransportError> {
+        let waited = Instant::now();
+        let generation =
+            sync.wait_board(robot, waited + BOARD_WAIT)
+                .ok_or(TransportError::NoCommandBoard {
+                    robot,
+                    waited_ms: waited.elapsed().as_millis(),
+                })?;
         let node = services::node(run, &format!("robot-{robot}"))?;
-        let frame_service = services::open_frame_service(&node)?;
-        let frame_subscriber =
-            frame_service
-                .subscriber_builder()
-                .create()
-                .map_err(|e| match e {
-                    SubscriberCreateError::ExceedsMaxSupportedSubscribers => {
-                        TransportError::ServiceFull {
-                            robot,
-                            service: services::frame_service_name(),
-                            limit: capacity as usize,
-                            what: "subscribers",
-                        }
-                    }
-                    other => TransportError::iceoryx("subscribing to the frames", other),
-                })?;
-        let command_service = services::open_command_service(&node, robot)?;
-        let command_publisher =
-            command_service
-                .publisher_builder()
-                .create()
-                .map_err(|e| match e {
-                    PublisherCreateError::ExceedsMaxSupportedPublishers => {
-                        TransportError::ServiceFull {
-                            robot,
-                            service: services::command_service_name(robot),
-                            limit: 1,
-                            what: "publishers",
-                        }
-                    }
-                    other => TransportError::iceoryx(
-                        format!("publishing robot {robot}'s commands"),
-                        other,
-                    ),
-                })?;
+        let frame_board = services::open_frame_board(&node)?;
+        let frame_reader = frame_board
+            .reader_builder()
+            .create()
+            .map_err(|e| TransportError::iceoryx("reading the frame board", e))?;
+        let frame_entry = frame_reader
+            .entry::<SensorFrame>(&robot)
+            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s frame entry"), e))?;
+        let command_board = services::open_command_board(&node, robot, generation)?;
+        let command_writer = command_board
+            .writer_builder()
+            .create()
+            .map_err(|e| match e {
+                WriterCreateError::ExceedsMaxSupportedWriters => TransportError::ServiceFull {
+                    robot,
+                    service: services::command_service_name(robot, generation),
+                    limit: 1,
+                    what: "writers",
+                },
+                other => {
+                    TransportError::iceoryx(format!("writing robot {robot}'s commands"), other)
+                }
+            })?;
+        let command_entry = command_writer
+            .entry::<ActuatorCommand>(&COMMAND_KEY)
+            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
         Ok(Ports {
-            frame_subscriber,
-            command_publisher,
-            _command_service: command_service,
-            _frame_service: frame_service,
+            frame_entry,
+            command_entry,
+            _frame_reader: frame_reader,
+            _command_writer: command_writer,
+            _command_board: command_board,
+            _frame_board: frame_board,
             _node: node,
         })
     }
@@ -151,45 +157,17 @@ impl AgentLink {
     /// run, [`TransportError::WorldGone`] when the world process died without ending it (checked every second
     /// of silence). An agent that fell behind skips straight to the newest tick.
     pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
-        let index = self.robot as usize;
         loop {
             if self.sync.stopped() {
                 return Ok(None);
             }
-            let newest = if self.pending.is_none() {
-                self.receive_frames()?
-            } else if self
-                .ports
-                .frame_subscriber
-                .has_samples()
-                .map_err(|e| TransportError::iceoryx("checking for frames", e))?
-            {
-                // Only one frame sample is ever borrowed: release the older one first.
-                self.pending = None;
-                self.receive_frames()?
-            } else {
-                None
-            };
-            if newest.is_some() {
-                self.pending = newest;
-            }
-            if let Some(sample) = self.pending.take() {
-                let Some(frame) = sample.payload().get(index) else {
-                    return Err(TransportError::InvalidSyncBlock {
-                        path: std::path::PathBuf::from(services::frame_service_name()),
-                        reason: format!(
-                            "a frame sample holds {} frames, robot {index} has none",
-                            sample.payload().len()
-                        ),
-                    });
-                };
-                let open = self.sync.tick();
+            let open = self.sync.tick();
+            if open > self.last_tick {
+                // The world writes every frame before it opens the tick, so an open tick's frame is in place.
+                let frame = *self.ports.frame_entry.get();
                 if frame.tick == open {
-                    return Ok(Some(TickFrame { sample, index }));
-                }
-                if frame.tick > open {
-                    // Published but not opened yet: keep it until the world opens its tick.
-                    self.pending = Some(sample);
+                    self.last_tick = open;
+                    return Ok(Some(TickFrame { frame }));
                 }
             }
             self.seen_epoch = self
@@ -199,33 +177,18 @@ impl AgentLink {
         }
     }
 
-    fn receive_frames(
-        &self,
-    ) -> Result<Option<Sample<ipc::Service, [SensorFrame], ()>>, TransportError> {
-        self.ports
-            .frame_subscriber
-            .receive()
-            .map_err(|e| TransportError::iceoryx("receiving the frames", e))
-    }
-
     /// Sends `command` as this robot's answer to `frame`'s tick (its `tick` and `robot` fields are set from the
-    /// frame) and releases the frame.
+    /// frame).
     pub fn answer(
         &mut self,
         frame: TickFrame,
         command: &ActuatorCommand,
     ) -> Result<(), TransportError> {
         let tick = frame.tick();
-        drop(frame);
         let mut answer = *command;
         answer.tick = tick;
         answer.robot = self.robot;
-        let sample = self.ports.command_publisher.loan_uninit().map_err(|e| {
-            TransportError::iceoryx(format!("loaning the command of tick {tick}"), e)
-        })?;
-        sample.write_payload(answer).send().map_err(|e| {
-            TransportError::iceoryx(format!("sending the command of tick {tick}"), e)
-        })?;
+        self.ports.command_entry.update_with_copy(answer);
         self.sync.claim(self.robot, tick);
         Ok(())
     }

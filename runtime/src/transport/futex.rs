@@ -11,8 +11,9 @@ use std::time::Duration;
 /// Blocks while `word` still holds `expected`, for at most `timeout` (forever when `None`).
 ///
 /// Returns on a wake-up, a value change, a signal or the timeout; callers re-check their condition in a loop,
-/// so every return is a "maybe" and no error is worth reporting.
-pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) {
+/// so every return is a "maybe". The result tells whether the timeout expired, so that callers can act on a
+/// long silence without reading the clock on every wake-up.
+pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) -> Waited {
     let spec = timeout.map(|t| libc::timespec {
         tv_sec: libc::time_t::try_from(t.as_secs()).unwrap_or(libc::time_t::MAX),
         tv_nsec: libc::c_long::from(t.subsec_nanos()),
@@ -21,7 +22,7 @@ pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) {
         .as_ref()
         .map_or(std::ptr::null(), |s| s as *const libc::timespec);
     // SAFETY: `word` is a live, aligned 32-bit atomic; the kernel only reads it. The timespec outlives the call.
-    unsafe {
+    let result = unsafe {
         libc::syscall(
             libc::SYS_futex,
             word.as_ptr(),
@@ -30,8 +31,22 @@ pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) {
             spec_ptr,
             std::ptr::null::<u32>(),
             0u32,
-        );
+        )
+    };
+    if result == -1 && std::io::Error::last_os_error().raw_os_error() == Some(libc::ETIMEDOUT) {
+        Waited::TimedOut
+    } else {
+        Waited::Woken
     }
+}
+
+/// How a [`wait`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Waited {
+    /// Woken, interrupted, or the word no longer held the expected value.
+    Woken,
+    /// The timeout expired.
+    TimedOut,
 }
 
 /// Wakes at most `count` processes blocked in [`wait`] on `word` (`i32::MAX` wakes all).

@@ -1,12 +1,12 @@
 //! Local transport of the lockstep tick protocol over iceoryx2 shared memory.
 //!
-//! One tick: the world fills every robot's [`SensorFrame`](crate::messages::SensorFrame) in one iceoryx2 slice
-//! sample and publishes it, then bumps one futex word that wakes every agent with a single system call. Each
-//! agent reads its own frame from that sample (zero-copy), publishes its
-//! [`ActuatorCommand`](crate::messages::ActuatorCommand) on its robot's own command service and bumps one
-//! shared acknowledgement counter; the last one wakes the world. The world waits on that one counter until every
-//! robot is accounted for or the tick's deadline passes, then reads each robot's command from its own service,
-//! so its view never depends on arrival order. docs/transport.md explains the choices.
+//! One tick: the world writes every robot's [`SensorFrame`](crate::messages::SensorFrame) into its entry of an
+//! iceoryx2 blackboard in shared memory, then bumps one futex word that wakes every agent with a single system
+//! call. Each agent loads its own frame entry, writes its [`ActuatorCommand`](crate::messages::ActuatorCommand)
+//! into its robot's own command board and bumps one shared acknowledgement counter; the last one wakes the
+//! world. The world waits on that one counter until every robot is accounted for or the tick's deadline passes,
+//! then reads each robot's command from its own board, so its view never depends on arrival order.
+//! docs/transport.md explains the choices.
 //!
 //! [`WorldLink`] is the world's side, [`AgentLink`] an agent's side, [`RunSpec`] names a run and cleans it up.
 
@@ -110,6 +110,17 @@ pub enum TransportError {
         /// Agents expected.
         expected: u32,
         /// How long the world waited.
+        waited_ms: u128,
+    },
+    /// The world did not provide a command board for a replacement agent in time.
+    #[error(
+        "robot {robot} cannot join: the world has not replaced its command board after {waited_ms} ms \
+         (it does so at the first tick after the death notice)"
+    )]
+    NoCommandBoard {
+        /// The robot index.
+        robot: u32,
+        /// How long the agent waited.
         waited_ms: u128,
     },
     /// The world process no longer exists and never ended the run.

@@ -1,34 +1,37 @@
 //! Names and limits of the iceoryx2 services of a run, in one place for the world (which creates them) and the
 //! agents (which only open them).
+//!
+//! Both services are iceoryx2 blackboards: fixed-size entries in shared memory that a writer updates in place and
+//! readers load lock-free. The frame board holds one entry per robot (the world writes, each agent reads its
+//! own); each robot has its own command board with one entry (its agent writes, the world reads), so no process
+//! can ever write another robot's command. A board's single writer slot stays taken when its writer dies, so
+//! after a death the world creates the next generation of that robot's command board for the replacement. docs/transport.md says why blackboards and not publish-subscribe.
 
 use iceoryx2::node::Node;
 use iceoryx2::prelude::{NodeBuilder, NodeName, ServiceName, SignalHandlingMode, ipc};
-use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
+use iceoryx2::service::builder::blackboard::BlackboardOpenError;
+use iceoryx2::service::port_factory::blackboard::PortFactory;
 
 use super::TransportError;
 use super::run::RunSpec;
 use crate::messages::{ActuatorCommand, MESSAGE_VERSION, SensorFrame};
 
-/// The service carrying every robot's frame as one slice sample per tick.
-pub(crate) type FrameService = PortFactory<ipc::Service, [SensorFrame], ()>;
-/// The service carrying one robot's commands.
-pub(crate) type CommandService = PortFactory<ipc::Service, ActuatorCommand, ()>;
+/// A blackboard of the run, keyed by robot index (frames) or by [`COMMAND_KEY`] (commands).
+pub(crate) type Board = PortFactory<ipc::Service, u32>;
 
-/// Frames queued per agent: only the newest matters, an older one is replaced (safe overflow).
-const FRAME_BUFFER: usize = 1;
-/// Commands queued per robot: a late answer to the previous tick plus the current one.
-const COMMAND_BUFFER: usize = 2;
-/// Nodes on a command service: the world and the robot's agent.
+/// The one key of a command board.
+pub(crate) const COMMAND_KEY: u32 = 0;
+/// Nodes on a command board: the world and the robot's agent.
 const COMMAND_NODES: usize = 2;
 
-/// Name of the frame service.
+/// Name of the frame board.
 pub(crate) fn frame_service_name() -> String {
     format!("swarm/v{MESSAGE_VERSION}/frames")
 }
 
-/// Name of robot `robot`'s command service.
-pub(crate) fn command_service_name(robot: u32) -> String {
-    format!("swarm/v{MESSAGE_VERSION}/commands/{robot}")
+/// Name of generation `generation` of robot `robot`'s command board.
+pub(crate) fn command_service_name(robot: u32, generation: u32) -> String {
+    format!("swarm/v{MESSAGE_VERSION}/commands/{robot}/{generation}")
 }
 
 fn service_name(name: &str) -> Result<ServiceName, TransportError> {
@@ -50,73 +53,68 @@ pub(crate) fn node(run: &RunSpec, name: &str) -> Result<Node<ipc::Service>, Tran
         })
 }
 
-/// World side: creates the frame service for `robots` agents.
-pub(crate) fn create_frame_service(
+/// World side: creates the frame board with one entry per robot, readable by `robots` agents.
+pub(crate) fn create_frame_board(
     node: &Node<ipc::Service>,
     robots: u32,
-) -> Result<FrameService, TransportError> {
+) -> Result<Board, TransportError> {
     let name = frame_service_name();
-    node.service_builder(&service_name(&name)?)
-        .publish_subscribe::<[SensorFrame]>()
-        .max_publishers(1)
-        .max_subscribers(robots as usize)
-        .max_nodes(robots as usize + 1)
-        .subscriber_max_buffer_size(FRAME_BUFFER)
-        .subscriber_max_borrowed_samples(1)
-        .history_size(0)
-        .enable_safe_overflow(true)
+    let mut creator = node
+        .service_builder(&service_name(&name)?)
+        .blackboard_creator::<u32>()
+        .max_readers(robots as usize)
+        .max_nodes(robots as usize + 1);
+    for robot in 0..robots {
+        creator = creator.add::<SensorFrame>(robot, SensorFrame::empty(robot));
+    }
+    creator
         .create()
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }
 
-/// Agent side: opens the frame service.
-pub(crate) fn open_frame_service(
-    node: &Node<ipc::Service>,
-) -> Result<FrameService, TransportError> {
+/// Agent side: opens the frame board.
+pub(crate) fn open_frame_board(node: &Node<ipc::Service>) -> Result<Board, TransportError> {
     let name = frame_service_name();
     node.service_builder(&service_name(&name)?)
-        .publish_subscribe::<[SensorFrame]>()
+        .blackboard_opener::<u32>()
         .open()
         .map_err(|e| TransportError::iceoryx(format!("opening service {name}"), e))
 }
 
-/// World side: creates robot `robot`'s command service (one publisher: the robot's agent).
-pub(crate) fn create_command_service(
+/// World side: creates generation `generation` of robot `robot`'s command board (one writer, the robot's
+/// agent; one reader, the world).
+pub(crate) fn create_command_board(
     node: &Node<ipc::Service>,
     robot: u32,
-) -> Result<CommandService, TransportError> {
-    let name = command_service_name(robot);
+    generation: u32,
+) -> Result<Board, TransportError> {
+    let name = command_service_name(robot, generation);
     node.service_builder(&service_name(&name)?)
-        .publish_subscribe::<ActuatorCommand>()
-        .max_publishers(1)
-        .max_subscribers(1)
+        .blackboard_creator::<u32>()
+        .max_readers(1)
         .max_nodes(COMMAND_NODES)
-        .subscriber_max_buffer_size(COMMAND_BUFFER)
-        .subscriber_max_borrowed_samples(1)
-        .history_size(0)
-        .enable_safe_overflow(true)
+        .add::<ActuatorCommand>(COMMAND_KEY, ActuatorCommand::idle(robot, 0))
         .create()
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }
 
-/// Agent side: opens robot `robot`'s command service.
-pub(crate) fn open_command_service(
+/// Agent side: opens generation `generation` of robot `robot`'s command board.
+pub(crate) fn open_command_board(
     node: &Node<ipc::Service>,
     robot: u32,
-) -> Result<CommandService, TransportError> {
-    let name = command_service_name(robot);
+    generation: u32,
+) -> Result<Board, TransportError> {
+    let name = command_service_name(robot, generation);
     node.service_builder(&service_name(&name)?)
-        .publish_subscribe::<ActuatorCommand>()
+        .blackboard_opener::<u32>()
         .open()
         .map_err(|e| match e {
-            iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError::ExceedsMaxNumberOfNodes => {
-                TransportError::ServiceFull {
-                    robot,
-                    service: name.clone(),
-                    limit: COMMAND_NODES,
-                    what: "nodes",
-                }
-            }
+            BlackboardOpenError::ExceedsMaxNumberOfNodes => TransportError::ServiceFull {
+                robot,
+                service: name.clone(),
+                limit: COMMAND_NODES,
+                what: "nodes",
+            },
             other => TransportError::iceoryx(format!("opening service {name}"), other),
         })
 }

@@ -22,7 +22,7 @@ use super::{TransportError, futex};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 1;
+const LAYOUT_VERSION: u32 = 2;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -65,6 +65,9 @@ struct RobotSlot {
     owner: AtomicU32,
     /// 1 after a death notice, until a replacement agent joins.
     dead: AtomicU32,
+    /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
+    /// death (a board's single writer slot stays taken by a dead writer, so a replacement gets a fresh board).
+    board: AtomicU32,
 }
 
 /// A mapping of a run's sync block.
@@ -113,6 +116,9 @@ impl SyncBlock {
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
+        for robot in 0..capacity {
+            block.publish_board(robot, 0);
+        }
         header.magic.store(MAGIC, Ordering::Release);
         Ok(block)
     }
@@ -325,10 +331,40 @@ impl SyncBlock {
     pub(crate) fn mark_dead(&self, robot: u32) {
         let slot = self.slot(robot);
         slot.dead.store(1, Ordering::SeqCst);
+        slot.board.store(0, Ordering::SeqCst);
         if slot.owner.swap(0, Ordering::AcqRel) == 1 {
             self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
         }
         self.claim(robot, self.header().tick.load(Ordering::SeqCst));
+    }
+
+    /// Whether `robot`'s command board awaits replacement after a death notice.
+    pub(crate) fn board_retired(&self, robot: u32) -> bool {
+        self.slot(robot).board.load(Ordering::Acquire) == 0
+    }
+
+    /// Generation `generation` of `robot`'s command board exists: agents may open it.
+    pub(crate) fn publish_board(&self, robot: u32, generation: u32) {
+        let board = &self.slot(robot).board;
+        board.store(generation + 1, Ordering::Release);
+        futex::wake(board, i32::MAX);
+    }
+
+    /// Waits until `robot`'s command board may be opened and returns its generation; `None` if `deadline`
+    /// passes first.
+    pub(crate) fn wait_board(&self, robot: u32, deadline: Instant) -> Option<u32> {
+        let board = &self.slot(robot).board;
+        loop {
+            let current = board.load(Ordering::Acquire);
+            if current != 0 {
+                return Some(current - 1);
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return None;
+            }
+            futex::wait(board, 0, Some(deadline - now));
+        }
     }
 
     /// Whether `robot` has a death notice and no replacement yet.
@@ -408,9 +444,8 @@ impl SyncBlock {
             if current != seen {
                 return Ok(current);
             }
-            let before = Instant::now();
-            futex::wait(epoch, seen, Some(WORLD_CHECK));
-            if before.elapsed() >= WORLD_CHECK && !self.world_alive() {
+            let waited = futex::wait(epoch, seen, Some(WORLD_CHECK));
+            if waited == futex::Waited::TimedOut && !self.world_alive() {
                 return Err(self.header().world_pid.load(Ordering::Relaxed));
             }
         }

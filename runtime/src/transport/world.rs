@@ -1,5 +1,6 @@
-//! The world's side of the lockstep: creates every service of the run with explicit limits, publishes each
-//! tick's frames, wakes the agents, waits on one counter and reads each robot's command from its own service.
+//! The world's side of the lockstep: creates every service of the run with explicit limits, writes each tick's
+//! frames into the frame board, wakes the agents, waits on one counter and reads each robot's command from its
+//! own command board.
 //!
 //! It must never let a dead or frozen robot block a tick (death notices and the tick deadline), never accept a
 //! command into a slot other than its robot's, and never let arrival order change what it reads.
@@ -9,14 +10,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::reader::{EntryHandle, Reader};
+use iceoryx2::port::writer::{EntryHandleMut, Writer};
 use iceoryx2::prelude::ipc;
-use iceoryx2::sample::Sample;
 
 use super::TransportError;
 use super::run::RunSpec;
-use super::services::{self, CommandService, FrameService};
+use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{MAX_ROBOTS, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
@@ -101,19 +101,59 @@ impl DeathNotices {
     }
 }
 
+/// The world's reading end of one robot's command board. Fields drop in declaration order: entry, port, service.
+struct CommandBoard {
+    entry: EntryHandle<ipc::Service, u32, ActuatorCommand>,
+    _reader: Reader<ipc::Service, u32>,
+    _board: Board,
+    generation: u32,
+}
+
+impl CommandBoard {
+    fn create(
+        node: &Node<ipc::Service>,
+        robot: u32,
+        generation: u32,
+    ) -> Result<CommandBoard, TransportError> {
+        let board = services::create_command_board(node, robot, generation)?;
+        let reader = board
+            .reader_builder()
+            .create()
+            .map_err(|e| TransportError::iceoryx(format!("reading robot {robot}'s commands"), e))?;
+        let entry = reader
+            .entry::<ActuatorCommand>(&COMMAND_KEY)
+            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
+        Ok(CommandBoard {
+            entry,
+            _reader: reader,
+            _board: board,
+            generation,
+        })
+    }
+}
+
+/// The world's iceoryx2 ports: one frame-board entry and one command board per robot, indexed by robot.
+/// Entry handles keep their ports and services alive; the other fields are only held, in drop order.
+struct Boards {
+    frame_entries: Vec<EntryHandleMut<ipc::Service, u32, SensorFrame>>,
+    commands: Vec<CommandBoard>,
+    _frame_writer: Writer<ipc::Service, u32>,
+    _frame_board: Board,
+}
+
 /// The world's end of a run's local transport.
 pub struct WorldLink {
     config: LinkConfig,
     tick: u64,
-    frame_publisher: Publisher<ipc::Service, [SensorFrame], ()>,
-    command_subscribers: Vec<Subscriber<ipc::Service, ActuatorCommand, ()>>,
-    commands: Vec<Option<Sample<ipc::Service, ActuatorCommand, ()>>>,
+    boards: Boards,
+    /// This tick's frames, filled by the caller and then written to the board.
+    frames: Vec<SensorFrame>,
+    /// The last tick's commands, valid where `status` says `Answered`.
+    commands: Vec<ActuatorCommand>,
     status: Vec<CommandStatus>,
     deaths: DeathNotices,
     notices_handled: u64,
     last_cleanup: u64,
-    _command_services: Vec<CommandService>,
-    _frame_service: FrameService,
     node: Node<ipc::Service>,
 }
 
@@ -128,29 +168,15 @@ impl WorldLink {
             });
         }
         let node = services::node(run, "world")?;
-        let frame_service = services::create_frame_service(&node, robots)?;
-        let frame_publisher = frame_service
-            .publisher_builder()
-            .initial_max_slice_len(robots as usize)
-            .max_loaned_samples(1)
-            .create()
-            .map_err(|e| TransportError::iceoryx("creating the frame publisher", e))?;
-        let mut command_services = Vec::with_capacity(robots as usize);
-        let mut command_subscribers = Vec::with_capacity(robots as usize);
-        for robot in 0..robots {
-            let service = services::create_command_service(&node, robot)?;
-            let subscriber = service.subscriber_builder().create().map_err(|e| {
-                TransportError::iceoryx(format!("subscribing to robot {robot}'s commands"), e)
-            })?;
-            command_services.push(service);
-            command_subscribers.push(subscriber);
-        }
+        let boards = Self::create_boards(&node, robots)?;
         // Last, so that a failure above leaves no sync block behind (iceoryx2 removes its own resources on drop).
         let sync = Arc::new(SyncBlock::create(&run.sync_block_path(), robots)?);
         tracing::debug!(run = run.name(), robots, "world link created");
         Ok(WorldLink {
             tick: 0,
-            commands: (0..robots).map(|_| None).collect(),
+            boards,
+            frames: (0..robots).map(SensorFrame::empty).collect(),
+            commands: (0..robots).map(|r| ActuatorCommand::idle(r, 0)).collect(),
             status: vec![CommandStatus::Missing; robots as usize],
             deaths: DeathNotices {
                 sync,
@@ -158,12 +184,32 @@ impl WorldLink {
             },
             notices_handled: 0,
             last_cleanup: 0,
-            frame_publisher,
-            command_subscribers,
-            _command_services: command_services,
-            _frame_service: frame_service,
             node,
             config,
+        })
+    }
+
+    fn create_boards(node: &Node<ipc::Service>, robots: u32) -> Result<Boards, TransportError> {
+        let frame_board = services::create_frame_board(node, robots)?;
+        let frame_writer = frame_board
+            .writer_builder()
+            .create()
+            .map_err(|e| TransportError::iceoryx("writing the frame board", e))?;
+        let frame_entries = (0..robots)
+            .map(|robot| {
+                frame_writer
+                    .entry::<SensorFrame>(&robot)
+                    .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s frame entry"), e))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let commands = (0..robots)
+            .map(|robot| CommandBoard::create(node, robot, 0))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Boards {
+            frame_entries,
+            commands,
+            _frame_writer: frame_writer,
+            _frame_board: frame_board,
         })
     }
 
@@ -211,29 +257,21 @@ impl WorldLink {
         sense: impl FnOnce(u64, &mut [SensorFrame]),
     ) -> Result<TickOutcome, TransportError> {
         let tick = self.tick + 1;
-        let robots = self.config.robots as usize;
-        for held in &mut self.commands {
-            *held = None;
-        }
-        let uninit = self
-            .frame_publisher
-            .loan_slice_uninit(robots)
-            .map_err(|e| {
-                TransportError::iceoryx(format!("loaning the frames of tick {tick}"), e)
-            })?;
-        let mut frames = uninit.write_from_fn(|i| {
-            let mut frame = SensorFrame::empty(i as u32);
+        for (i, frame) in self.frames.iter_mut().enumerate() {
+            *frame = SensorFrame::empty(i as u32);
             frame.tick = tick;
-            frame
-        });
-        sense(tick, frames.payload_mut());
-        for (i, frame) in frames.payload_mut().iter_mut().enumerate() {
+        }
+        sense(tick, &mut self.frames);
+        for ((i, frame), entry) in self
+            .frames
+            .iter_mut()
+            .enumerate()
+            .zip(&self.boards.frame_entries)
+        {
             frame.tick = tick;
             frame.robot = i as u32;
+            entry.update_with_copy(*frame);
         }
-        frames.send().map_err(|e| {
-            TransportError::iceoryx(format!("publishing the frames of tick {tick}"), e)
-        })?;
 
         let sync = &self.deaths.sync;
         sync.open_tick(tick);
@@ -243,33 +281,25 @@ impl WorldLink {
         if !sync.wait_answers(tick, self.config.spin, deadline) {
             tracing::debug!(tick, "tick deadline passed with answers missing");
         }
-        let outcome = self.collect(tick)?;
+        let outcome = self.collect(tick);
         self.cleanup_if_due(tick);
         Ok(outcome)
     }
 
-    /// Reads each robot's command for `tick` from its own service into its slot.
-    fn collect(&mut self, tick: u64) -> Result<TickOutcome, TransportError> {
+    /// Reads each robot's command for `tick` from its own board into its slot.
+    fn collect(&mut self, tick: u64) -> TickOutcome {
         let mut outcome = TickOutcome {
             tick,
             answered: 0,
             missing: 0,
             dead: 0,
         };
-        for (robot, subscriber) in self.command_subscribers.iter().enumerate() {
-            let slot = &mut self.commands[robot];
-            loop {
-                let received = subscriber.receive().map_err(|e| {
-                    TransportError::iceoryx(format!("receiving robot {robot}'s command"), e)
-                })?;
-                let Some(sample) = received else { break };
-                let command = sample.payload();
-                // Late answers to earlier ticks are dropped; the service has a single publisher, the robot's agent.
-                if slot.is_none() && command.tick == tick && command.robot == robot as u32 {
-                    *slot = Some(sample);
-                }
-            }
-            self.status[robot] = if slot.is_some() {
+        for (robot, board) in self.boards.commands.iter().enumerate() {
+            let command = *board.entry.get();
+            // A late answer to an earlier tick is not this tick's answer; the board has a single writer, the
+            // robot's agent, so `robot` can only be wrong if the agent is broken.
+            self.status[robot] = if command.tick == tick && command.robot == robot as u32 {
+                self.commands[robot] = command;
                 outcome.answered += 1;
                 CommandStatus::Answered
             } else if self.deaths.sync.is_dead(robot as u32) {
@@ -280,7 +310,7 @@ impl WorldLink {
                 CommandStatus::Missing
             };
         }
-        Ok(outcome)
+        outcome
     }
 
     fn cleanup_if_due(&mut self, tick: u64) {
@@ -292,15 +322,34 @@ impl WorldLink {
             self.last_cleanup = tick;
             let state = self.node.try_cleanup_dead_nodes();
             tracing::debug!(tick, ?state, "dead-node cleanup");
+            self.renew_retired_boards();
         }
     }
 
-    /// The command `robot` sent in the last tick, read in place from shared memory; `None` if it did not answer.
+    /// Gives every robot with a death notice a fresh command board for its replacement agent.
+    fn renew_retired_boards(&mut self) {
+        let sync = &self.deaths.sync;
+        for (robot, board) in (0..).zip(self.boards.commands.iter_mut()) {
+            if !sync.board_retired(robot) {
+                continue;
+            }
+            let generation = board.generation + 1;
+            match CommandBoard::create(&self.node, robot, generation) {
+                Ok(fresh) => {
+                    *board = fresh;
+                    sync.publish_board(robot, generation);
+                }
+                Err(e) => tracing::warn!(robot, generation, "replacing a command board: {e}"),
+            }
+        }
+    }
+
+    /// The command `robot` sent in the last tick; `None` if it did not answer.
     pub fn command(&self, robot: u32) -> Option<&ActuatorCommand> {
-        self.commands
-            .get(robot as usize)
-            .and_then(|held| held.as_ref())
-            .map(|sample| sample.payload())
+        match self.status.get(robot as usize) {
+            Some(CommandStatus::Answered) => self.commands.get(robot as usize),
+            _ => None,
+        }
     }
 
     /// What the world got from each robot in the last tick, indexed by robot.
