@@ -46,6 +46,10 @@ enum Commands {
         /// Do not draw a progress bar.
         #[arg(long)]
         no_progress: bool,
+        /// Real-time mode: pace the ticks at the configuration's ticks_per_second; summary.json says whether
+        /// every tick kept its slot.
+        #[arg(long)]
+        real_time: bool,
     },
 }
 
@@ -70,6 +74,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
             tick_deadline_ms,
             no_progress,
+            real_time,
         } => {
             let stop = Arc::new(AtomicBool::new(false));
             let flag = Arc::clone(&stop);
@@ -83,6 +88,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 out,
                 progress: !no_progress,
                 tick_deadline: tick_deadline_ms.map(Duration::from_millis),
+                real_time,
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;

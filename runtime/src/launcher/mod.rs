@@ -60,6 +60,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// How long a tick waits for a missing command (default: the transport's).
     pub tick_deadline: Option<Duration>,
+    /// Pace the ticks at the configuration's ticks_per_second (real-time mode) instead of running flat out.
+    pub real_time: bool,
 }
 
 /// What a finished run reports.
@@ -227,6 +229,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         out: out_dir.clone(),
         tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
         join_timeout_ms: 120_000,
+        real_time: options.real_time,
     };
     let mut world = children::spawn(
         Command::new(&binaries.world)

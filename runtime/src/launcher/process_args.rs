@@ -59,6 +59,9 @@ pub struct WorldArgs {
     /// Milliseconds the world waits for every agent to join before the first tick.
     #[arg(long = "join-timeout-ms", default_value_t = 120_000)]
     pub join_timeout_ms: u64,
+    /// Pace the ticks at the configuration's ticks_per_second instead of running as fast as possible.
+    #[arg(long = "real-time")]
+    pub real_time: bool,
 }
 
 impl WorldArgs {
@@ -82,6 +85,9 @@ impl WorldArgs {
         }
         if let Some(ms) = self.tick_deadline_ms {
             args.extend(["--tick-deadline-ms".into(), ms.to_string()]);
+        }
+        if self.real_time {
+            args.push("--real-time".into());
         }
         args
     }
@@ -167,6 +173,7 @@ mod tests {
             out: PathBuf::from("runs/x"),
             tick_deadline_ms: Some(250),
             join_timeout_ms: 5_000,
+            real_time: true,
         };
         let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
         assert_eq!(World::parse_from(line).args, args);

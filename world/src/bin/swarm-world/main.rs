@@ -8,6 +8,7 @@
 //! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`.
 
 mod events;
+mod pacing;
 
 use std::io::{BufRead, Write};
 use std::process::ExitCode;
@@ -28,6 +29,7 @@ use swarm_world::entities::RobotId;
 use swarm_world::recorder::Recorder;
 
 use events::EventsWriter;
+use pacing::Pacer;
 
 /// Minimum interval between two progress reports to the launcher.
 const REPORT_INTERVAL: Duration = Duration::from_millis(50);
@@ -120,6 +122,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     link.wait_for_agents(Duration::from_millis(args.join_timeout_ms))
         .context("waiting for the robot agents to join")?;
     let started = Instant::now();
+    let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
@@ -155,7 +158,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         events.flush()?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);
-        if last_report.elapsed() >= REPORT_INTERVAL {
+        if outcome.tick == 1 || last_report.elapsed() >= REPORT_INTERVAL {
             last_report = Instant::now();
             report(WorldReport::Tick {
                 tick: outcome.tick,
@@ -164,6 +167,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
                 dead: outcome.dead,
             });
         }
+        pacer.end_of_tick(outcome.tick);
     }
     let ticking = started.elapsed().as_secs_f64();
     let ticks = link.tick();
@@ -173,6 +177,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
+        "real_time": pacer.summary(ticks),
     });
     recorder.finish(&world, extra)?;
     events.flush()?;
