@@ -5,6 +5,7 @@
 //! configuration ([`config`]) and the [`launcher`] behind `swarm`. It never depends on the world or on the robot
 //! agent.
 
+pub mod bench;
 pub mod config;
 pub mod launcher;
 pub mod logging;

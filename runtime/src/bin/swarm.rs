@@ -12,6 +12,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
+use swarm_runtime::bench::BenchOptions;
 use swarm_runtime::launcher::{self, RunOptions};
 
 /// Runs swarms of robot processes executing ptSCT supervisors.
@@ -51,6 +52,41 @@ enum Commands {
         #[arg(long)]
         real_time: bool,
     },
+    /// Benchmark: the whole system at ARGoS' obstacle-avoidance density (one process per robot), the bare
+    /// lockstep transport, and a real-time check; prints Markdown tables and writes <out>/bench.json.
+    Bench(BenchArgs),
+}
+
+/// Flags of `swarm bench`.
+#[derive(Debug, clap::Args)]
+struct BenchArgs {
+    /// Robot counts, comma-separated (each needs <configs>/density_N<N>.argos).
+    #[arg(long, value_delimiter = ',', default_values_t = [10, 100, 1000])]
+    sizes: Vec<u32>,
+    /// Folder of the density configurations.
+    #[arg(long, default_value = "configs/obstacle_avoidance")]
+    configs: PathBuf,
+    /// Ticks per whole-system run (default 200,000 / N, clamped to 200..2,000).
+    #[arg(long)]
+    ticks: Option<u64>,
+    /// Whole-system runs per size; figures are medians.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
+    /// Folder for run directories and bench.json.
+    #[arg(long, default_value = "runs/bench")]
+    out: PathBuf,
+    /// Skip the whole-system runs.
+    #[arg(long)]
+    no_system: bool,
+    /// Skip the bare lockstep.
+    #[arg(long)]
+    no_bare: bool,
+    /// Also run a real-time check with this many robots (needs density_N<N>.argos; N = 2000 ships at 10 ticks/s).
+    #[arg(long)]
+    real_time_robots: Option<u32>,
+    /// Ticks of the real-time check.
+    #[arg(long, default_value_t = swarm_runtime::bench::DEFAULT_REAL_TIME_TICKS)]
+    real_time_ticks: u64,
 }
 
 fn main() -> ExitCode {
@@ -64,8 +100,44 @@ fn main() -> ExitCode {
     }
 }
 
+fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let options = BenchOptions {
+        configs_dir: args.configs,
+        sizes: args.sizes,
+        ticks: args.ticks,
+        repeat: args.repeat,
+        out: args.out.clone(),
+        system: !args.no_system,
+        bare: !args.no_bare,
+        real_time_robots: args.real_time_robots,
+        real_time_ticks: args.real_time_ticks,
+    };
+    let progress = indicatif::ProgressBar::new_spinner();
+    progress.enable_steady_tick(Duration::from_millis(200));
+    progress.set_message("measuring");
+    let report = swarm_runtime::bench::run(&options, &stop, |partial| {
+        progress.set_message(format!(
+            "measured {} whole-system, {} bare, {} real-time",
+            partial.system.len(),
+            partial.bare.len(),
+            usize::from(partial.real_time.is_some())
+        ));
+    })?;
+    progress.finish_and_clear();
+    print!("{}", swarm_runtime::bench::markdown(&report));
+    println!("written: {}", args.out.join("bench.json").display());
+    Ok(())
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Commands::Bench(args) => bench(args),
         Commands::Run {
             config,
             robots,

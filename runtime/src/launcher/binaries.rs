@@ -13,6 +13,8 @@ use std::process::Command;
 pub const WORLD_PROGRAM: &str = "swarm-world";
 /// File name of the robot agent program.
 pub const AGENT_PROGRAM: &str = "robot-agent";
+/// File name of the bare lockstep agent (no player), used by `swarm bench`.
+pub const LOCKSTEP_AGENT_PROGRAM: &str = "swarm-lockstep-agent";
 
 /// Why the programs of a run could not be found.
 #[derive(Debug, thiserror::Error)]
@@ -61,29 +63,39 @@ pub struct Binaries {
 impl Binaries {
     /// Finds (and, under cargo, builds) the world and agent programs.
     pub fn locate() -> Result<Binaries, BinariesError> {
-        let dir = match std::env::var_os("SWARM_BIN_DIR") {
-            Some(dir) => PathBuf::from(dir),
-            None => {
-                let own = std::env::current_exe().map_err(BinariesError::OwnPath)?;
-                let dir = own.parent().map(Path::to_path_buf).unwrap_or_default();
-                if let Some(cargo) = std::env::var_os("CARGO") {
-                    build_with_cargo(&cargo.to_string_lossy(), &dir)?;
-                }
-                dir
-            }
-        };
-        let find = |program: &'static str| {
-            let path = dir.join(program);
-            if path.is_file() {
-                Ok(path)
-            } else {
-                Err(BinariesError::Missing { program, path })
-            }
-        };
+        let dir = program_dir()?;
         Ok(Binaries {
-            world: find(WORLD_PROGRAM)?,
-            agent: find(AGENT_PROGRAM)?,
+            world: find(&dir, WORLD_PROGRAM)?,
+            agent: find(&dir, AGENT_PROGRAM)?,
         })
+    }
+
+    /// Finds (and, under cargo, builds) one more program of the workspace that lives beside the world and agent
+    /// programs, e.g. [`LOCKSTEP_AGENT_PROGRAM`].
+    pub fn locate_program(program: &'static str) -> Result<PathBuf, BinariesError> {
+        find(&program_dir()?, program)
+    }
+}
+
+/// The folder of the run's programs: `SWARM_BIN_DIR`, or the launcher's own folder (built first under cargo).
+fn program_dir() -> Result<PathBuf, BinariesError> {
+    if let Some(dir) = std::env::var_os("SWARM_BIN_DIR") {
+        return Ok(PathBuf::from(dir));
+    }
+    let own = std::env::current_exe().map_err(BinariesError::OwnPath)?;
+    let dir = own.parent().map(Path::to_path_buf).unwrap_or_default();
+    if let Some(cargo) = std::env::var_os("CARGO") {
+        build_with_cargo(&cargo.to_string_lossy(), &dir)?;
+    }
+    Ok(dir)
+}
+
+fn find(dir: &Path, program: &'static str) -> Result<PathBuf, BinariesError> {
+    let path = dir.join(program);
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(BinariesError::Missing { program, path })
     }
 }
 
@@ -107,6 +119,8 @@ fn build_with_cargo(cargo: &str, dir: &Path) -> Result<(), BinariesError> {
         "swarm-world",
         "-p",
         "robot-agent",
+        "-p",
+        "swarm-runtime",
         "--bins",
     ]);
     match profile {
@@ -119,7 +133,7 @@ fn build_with_cargo(cargo: &str, dir: &Path) -> Result<(), BinariesError> {
         }
     }
     let shown = format!("{command:?}");
-    tracing::info!(command = %shown, "building the world and agent programs");
+    tracing::info!(command = %shown, "building the world, agent and runtime programs");
     let status = command.status().map_err(|source| BinariesError::Cargo {
         cargo: cargo.to_owned(),
         source,
