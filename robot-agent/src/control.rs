@@ -6,6 +6,7 @@
 
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_runtime::player::{Player, PlayerError};
+use swarm_runtime::supervisor_gen::compiled::SupervisorSet;
 use thiserror::Error;
 use tracing::info;
 
@@ -79,6 +80,25 @@ impl Control {
     }
 }
 
+/// Loads (or synthesises) the supervisor set of a supervised plan; `None` for a native controller.
+pub fn supervisor_set(plan: &Plan) -> Result<Option<SupervisorSet>, BuildError> {
+    match plan {
+        Plan::Supervised { supervisors, .. } => load_set(supervisors).map(Some),
+        Plan::Native { .. } => Ok(None),
+    }
+}
+
+fn load_set(source: &Supervisors) -> Result<SupervisorSet, BuildError> {
+    let loaded = match source {
+        Supervisors::Builtin(_, models) => supervisors::synthesise(models),
+        Supervisors::Files(files) => supervisors::load(files),
+    };
+    loaded.map_err(|problem| BuildError::Supervisors {
+        where_: source.to_string(),
+        problem,
+    })
+}
+
 /// Loads, binds and checks everything `plan` needs, with parameters from `params`, for robot `robot` of a run
 /// seeded with `run_seed` (the player's random stream).
 pub fn build(
@@ -93,14 +113,7 @@ pub fn build(
             supervisors,
         } => {
             let where_ = supervisors.to_string();
-            let loaded = match supervisors {
-                Supervisors::Builtin(_, models) => supervisors::synthesise(models),
-                Supervisors::Files(files) => supervisors::load(files),
-            };
-            let set = loaded.map_err(|problem| BuildError::Supervisors {
-                where_: where_.clone(),
-                problem,
-            })?;
+            let set = load_set(supervisors)?;
             let callbacks = profiles::bind_profile(profile, params, &set.events)?;
             info!(
                 profile = profile.as_str(),

@@ -4,10 +4,12 @@
 //! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes become the [`Params`] of its profile or native
 //! controller, and relative paths in them resolve against the configuration's folder.
 
+use std::path::Path;
+
 use swarm_runtime::config::{Controller, Diagnostic, Experiment, Location};
 
 use crate::control::{self, Control};
-use crate::controller::{self, Plan};
+use crate::controller::{self, Plan, Supervisors};
 use crate::params::Params;
 
 /// The controller of robot `robot` (its index in the canonical robot order, `Arena::robots`).
@@ -69,12 +71,14 @@ pub fn params_of(controller: &Controller) -> Params {
 }
 
 /// Plans and builds `controller` of `experiment` for robot `robot` of a run seeded with `run_seed`; any failure
-/// is located at the controller's `<params>` element.
+/// is located at the controller's `<params>` element. `compiled`, when given, is the controller's supervisor set
+/// already compiled (by the launcher, once per run) and replaces the supervisors its parameters name.
 pub fn build(
     experiment: &Experiment,
     controller: &Controller,
     run_seed: u64,
     robot: u32,
+    compiled: Option<&Path>,
 ) -> Result<(Plan, Control), Diagnostic> {
     let params = params_of(controller);
     let located = |message: String| {
@@ -86,8 +90,13 @@ pub fn build(
             ),
         )
     };
-    let plan = controller::plan(&controller.tag, &params, experiment.base_dir())
+    let mut plan = controller::plan(&controller.tag, &params, experiment.base_dir())
         .map_err(|e| located(e.to_string()))?;
+    if let Some(file) = compiled
+        && let Plan::Supervised { supervisors, .. } = &mut plan
+    {
+        *supervisors = Supervisors::Files(vec![file.to_path_buf()]);
+    }
     let control =
         control::build(&plan, &params, run_seed, robot).map_err(|e| located(e.to_string()))?;
     Ok((plan, control))
@@ -158,7 +167,7 @@ mod tests {
     #[test]
     fn thesis_controller_builds_from_the_config() {
         let e = experiment();
-        let (plan, _) = build(&e, controller_of(&e, 0).unwrap(), 1, 0).unwrap();
+        let (plan, _) = build(&e, controller_of(&e, 0).unwrap(), 1, 0, None).unwrap();
         assert_eq!(
             plan.to_string(),
             "profile `obstacle_avoidance` with supervisors built-in obstacle_avoidance/ptsct"
@@ -168,7 +177,7 @@ mod tests {
     #[test]
     fn bad_param_is_located_at_the_params_element() {
         let e = experiment();
-        let err = build(&e, controller_of(&e, 1).unwrap(), 1, 0)
+        let err = build(&e, controller_of(&e, 1).unwrap(), 1, 0, None)
             .err()
             .unwrap()
             .to_string();

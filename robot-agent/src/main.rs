@@ -3,13 +3,13 @@
 //! the reason for the launcher to report; then joins the run and answers every tick: wait for the frame, step
 //! the controller, send the command.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use clap::Parser;
 use robot_agent::control::{self, Control};
-use robot_agent::controller;
+use robot_agent::controller::{self, Plan};
 use robot_agent::from_config;
 use robot_agent::params::Params;
 use swarm_runtime::config::Experiment;
@@ -56,10 +56,18 @@ struct Args {
     /// Number of robots of the run, when `swarm run --robots` changed the configuration's count (with --config).
     #[arg(long, requires = "config")]
     robots: Option<u32>,
+    /// With --config: load this compiled supervisor-set file instead of the supervisors the controller's
+    /// parameters name (the launcher compiles each controller's models once per run).
+    #[arg(long = "compiled-supervisors", requires = "config")]
+    compiled_supervisors: Option<PathBuf>,
     /// Load, synthesise and bind the controller, print its event names by id as a JSON array on standard output,
     /// then exit without joining the run.
     #[arg(long)]
     check: bool,
+    /// With --check: also write the controller's compiled supervisor set to this file (nothing for a native
+    /// controller).
+    #[arg(long = "write-supervisors", requires = "check")]
+    write_supervisors: Option<PathBuf>,
 }
 
 fn parse_param(s: &str) -> Result<(String, String), String> {
@@ -70,7 +78,7 @@ fn parse_param(s: &str) -> Result<(String, String), String> {
 }
 
 /// Plans and builds the robot's controller from the configuration or from the manual flags.
-fn build_control(args: &Args) -> Result<Control> {
+fn build_control(args: &Args) -> Result<(Plan, Control)> {
     if let Some(path) = &args.config {
         let (experiment, warnings) =
             Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
@@ -94,12 +102,18 @@ fn build_control(args: &Args) -> Result<Control> {
             Some(id) => from_config::controller_by_id(&experiment, id)?,
             None => from_config::controller_of(&experiment, args.robot)?,
         };
-        let (plan, control) = from_config::build(&experiment, controller, seed, args.robot)?;
+        let (plan, control) = from_config::build(
+            &experiment,
+            controller,
+            seed,
+            args.robot,
+            args.compiled_supervisors.as_deref(),
+        )?;
         info!(
             controller = controller.id.as_str(),
             seed, "robot runs {plan}"
         );
-        return Ok(control);
+        return Ok((plan, control));
     }
     let mut pairs = args.params.clone();
     if let (Some(profile), Some(supervisors)) = (&args.profile, &args.supervisors) {
@@ -112,7 +126,17 @@ fn build_control(args: &Args) -> Result<Control> {
     let seed = args.seed.unwrap_or(0);
     let control = control::build(&plan, &params, seed, args.robot)?;
     info!(seed, "robot runs {plan}");
-    Ok(control)
+    Ok((plan, control))
+}
+
+/// Writes the compiled supervisor set of `plan` to `path` (nothing for a native controller).
+fn write_supervisors(plan: &Plan, path: &Path) -> Result<()> {
+    if let Some(set) = control::supervisor_set(plan)? {
+        set.write(path)
+            .with_context(|| format!("writing the compiled supervisors to {}", path.display()))?;
+        info!(file = %path.display(), "compiled supervisor set written");
+    }
+    Ok(())
 }
 
 /// Answers every tick of the run until the world ends it.
@@ -135,9 +159,12 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
 }
 
 fn run(args: &Args) -> Result<()> {
-    let mut control = build_control(args)
+    let (plan, mut control) = build_control(args)
         .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
     let Some(root) = args.iox_root.as_deref().filter(|_| !args.check) else {
+        if let Some(path) = &args.write_supervisors {
+            write_supervisors(&plan, path)?;
+        }
         info!(robot = args.robot, "controller checked");
         println!("{}", serde_json::to_string(&control.event_names())?);
         return Ok(());

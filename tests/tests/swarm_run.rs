@@ -82,6 +82,17 @@ fn forty_robot_run_completes_with_one_process_per_robot() {
         events.contains(",Go\n") && events.contains(",saw-obs\n"),
         "events are recorded by name"
     );
+    let compiled = out.path().join("supervisors").join("fdc.ptsct");
+    assert!(compiled.is_file(), "the launcher compiles the models once");
+    let logs = std::fs::read_dir(out.path().join("logs")).expect("agent logs");
+    for log in logs.flatten() {
+        let text = std::fs::read_to_string(log.path()).expect("agent log");
+        assert!(
+            text.contains("fdc.ptsct"),
+            "{} loaded the run's compiled supervisors",
+            log.path().display()
+        );
+    }
 }
 
 #[test]

@@ -16,6 +16,7 @@ pub mod process_args;
 pub mod run_dir;
 pub mod world_report;
 
+use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{ChildStdin, Command, Stdio};
@@ -208,7 +209,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
     tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
 
-    check_controllers(
+    let compiled = check_controllers(
         &binaries,
         &run_args,
         &config,
@@ -253,6 +254,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             controller: entry.epuck.controller.clone(),
             seed,
             robots: options.robots,
+            compiled_supervisors: compiled.get(&entry.epuck.controller).cloned(),
         };
         let log_path = run_dir::agent_log(&out_dir, robot as u32);
         let log = std::fs::File::create(&log_path)
@@ -312,9 +314,14 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
 /// File in the run directory with each controller's event names by id, for the world's `events.csv`.
 pub const EVENT_TABLES_FILE: &str = "event_tables.json";
 
+/// Folder of the run directory holding each controller's compiled supervisor set.
+pub const COMPILED_SUPERVISORS_DIR: &str = "supervisors";
+
 /// Builds every controller of the run once, before any process of the run starts (`robot-agent --check` for the
 /// first robot of each controller), so a missing callback or a bad supervisor file fails the run at once with the
-/// agent's reason; records each controller's event names in [`EVENT_TABLES_FILE`].
+/// agent's reason; records each controller's event names in [`EVENT_TABLES_FILE`]. The check also compiles each
+/// supervised controller's models once, into `supervisors/<controller>.ptsct` of the run directory; returns those
+/// files by controller id, for the agents to load instead of synthesising the models again.
 fn check_controllers(
     binaries: &Binaries,
     run_args: &RunArgs,
@@ -323,7 +330,11 @@ fn check_controllers(
     robots: Option<u32>,
     roster: &[crate::config::Robot<'_>],
     out_dir: &Path,
-) -> Result<(), LaunchError> {
+) -> Result<HashMap<String, PathBuf>, LaunchError> {
+    let compiled_dir = out_dir.join(COMPILED_SUPERVISORS_DIR);
+    std::fs::create_dir_all(&compiled_dir)
+        .map_err(io(format!("creating {}", compiled_dir.display())))?;
+    let mut compiled = HashMap::new();
     let mut tables = serde_json::Map::new();
     for robot in roster {
         let controller = &robot.epuck.controller;
@@ -337,10 +348,14 @@ fn check_controllers(
             controller: controller.clone(),
             seed,
             robots,
+            compiled_supervisors: None,
         };
+        let compiled_file = compiled_dir.join(format!("{controller}.ptsct"));
         let output = Command::new(&binaries.agent)
             .args(args.to_args())
             .arg("--check")
+            .arg("--write-supervisors")
+            .arg(&compiled_file)
             .stdin(Stdio::null())
             .output()
             .map_err(io(format!("starting {}", binaries.agent.display())))?;
@@ -356,10 +371,15 @@ fn check_controllers(
         }
         let names: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap_or_default();
         tables.insert(controller.clone(), names);
+        // Native controllers have no supervisors: no file, and their agents get no flag.
+        if compiled_file.is_file() {
+            compiled.insert(controller.clone(), compiled_file);
+        }
     }
     let path = out_dir.join(EVENT_TABLES_FILE);
     let text = serde_json::to_string_pretty(&serde_json::Value::Object(tables)).unwrap_or_default();
-    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))
+    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))?;
+    Ok(compiled)
 }
 
 /// A seed from the clock, for configurations that ask for one.

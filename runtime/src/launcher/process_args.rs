@@ -114,6 +114,10 @@ pub struct AgentArgs {
     /// Number of robots of the run, when `swarm run --robots` changed the configuration's count.
     #[arg(long)]
     pub robots: Option<u32>,
+    /// The controller's supervisor set, compiled once per run by the launcher; replaces the controller's
+    /// `supervisors` parameter, so N agents do not synthesise the same models N times.
+    #[arg(long = "compiled-supervisors")]
+    pub compiled_supervisors: Option<PathBuf>,
 }
 
 impl AgentArgs {
@@ -132,6 +136,9 @@ impl AgentArgs {
         ]);
         if let Some(robots) = self.robots {
             args.extend(["--robots".into(), robots.to_string()]);
+        }
+        if let Some(file) = &self.compiled_supervisors {
+            args.extend(["--compiled-supervisors".into(), file.display().to_string()]);
         }
         args
     }
@@ -188,6 +195,7 @@ mod tests {
             controller: "fdc".into(),
             seed: 124,
             robots: Some(40),
+            compiled_supervisors: Some(PathBuf::from("runs/x/supervisors/fdc.ptsct")),
         };
         let line = std::iter::once("robot-agent".to_string()).chain(args.to_args());
         assert_eq!(Agent::parse_from(line).args, args);
