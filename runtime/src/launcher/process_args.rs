@@ -59,6 +59,9 @@ pub struct WorldArgs {
     /// Milliseconds the world waits for every agent to join before the first tick.
     #[arg(long = "join-timeout-ms", default_value_t = 120_000)]
     pub join_timeout_ms: u64,
+    /// Faults given on the command line (`swarm run --fault`), added to the configuration's `<faults>`.
+    #[arg(long = "fault")]
+    pub faults: Vec<String>,
 }
 
 impl WorldArgs {
@@ -82,6 +85,9 @@ impl WorldArgs {
         }
         if let Some(ms) = self.tick_deadline_ms {
             args.extend(["--tick-deadline-ms".into(), ms.to_string()]);
+        }
+        for fault in &self.faults {
+            args.extend(["--fault".into(), fault.clone()]);
         }
         args
     }
@@ -108,6 +114,9 @@ pub struct AgentArgs {
     /// Number of robots of the run, when `swarm run --robots` changed the configuration's count.
     #[arg(long)]
     pub robots: Option<u32>,
+    /// A restarted agent's resume point (`launcher::resume`): its supervisors continue from it.
+    #[arg(long)]
+    pub resume: Option<PathBuf>,
 }
 
 impl AgentArgs {
@@ -126,6 +135,9 @@ impl AgentArgs {
         ]);
         if let Some(robots) = self.robots {
             args.extend(["--robots".into(), robots.to_string()]);
+        }
+        if let Some(resume) = &self.resume {
+            args.extend(["--resume".into(), resume.display().to_string()]);
         }
         args
     }
@@ -167,6 +179,7 @@ mod tests {
             out: PathBuf::from("runs/x"),
             tick_deadline_ms: Some(250),
             join_timeout_ms: 5_000,
+            faults: vec!["kill robots=3 tick=50".into()],
         };
         let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
         assert_eq!(World::parse_from(line).args, args);
@@ -181,6 +194,7 @@ mod tests {
             controller: "fdc".into(),
             seed: 124,
             robots: Some(40),
+            resume: Some(PathBuf::from("runs/x/resume/robot-7.json")),
         };
         let line = std::iter::once("robot-agent".to_string()).chain(args.to_args());
         assert_eq!(Agent::parse_from(line).args, args);

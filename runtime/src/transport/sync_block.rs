@@ -336,6 +336,28 @@ impl SyncBlock {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
     }
 
+    /// Whether `robot` has a connected agent and no death notice.
+    pub(crate) fn has_agent(&self, robot: u32) -> bool {
+        let slot = self.slot(robot);
+        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
+    }
+
+    /// Withdraws a death notice for a robot whose agent is still connected (it was frozen, or late): it owns
+    /// the robot again and ticks wait for it again. `false` if another agent claimed the robot meanwhile.
+    pub(crate) fn revive(&self, robot: u32) -> bool {
+        let slot = self.slot(robot);
+        if slot
+            .owner
+            .compare_exchange(0, 1, Ordering::AcqRel, Ordering::Acquire)
+            .is_err()
+        {
+            return false;
+        }
+        slot.dead.store(0, Ordering::SeqCst);
+        self.header().joined.0.fetch_add(1, Ordering::AcqRel);
+        true
+    }
+
     /// An agent claims `robot` before it connects, so that a second agent for the same robot fails fast.
     pub(crate) fn claim_robot(&self, robot: u32) -> JoinClaim {
         match self

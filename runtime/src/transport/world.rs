@@ -203,6 +203,18 @@ impl WorldLink {
         self.deaths.mark_dead(robot)
     }
 
+    /// Whether `robot` has a connected agent without a death notice (e.g. a replacement agent has joined).
+    pub fn agent_present(&self, robot: u32) -> bool {
+        robot < self.config.robots && self.deaths.sync.has_agent(robot)
+    }
+
+    /// Withdraws the death notice of `robot`, whose agent is still connected (thawed, or answering again after
+    /// missing deadlines): from the next tick on, ticks wait for it again. `false` when the robot is out of
+    /// range or another agent has claimed it meanwhile.
+    pub fn revive(&self, robot: u32) -> bool {
+        robot < self.config.robots && self.deaths.sync.revive(robot)
+    }
+
     /// Runs one tick: `sense` fills every robot's frame (pre-set to [`SensorFrame::empty`] with this tick;
     /// `tick` and `robot` are enforced afterwards), the frames go out, and the call returns when every robot
     /// answered, is dead, or the deadline passed. Read the commands with [`WorldLink::command`].
