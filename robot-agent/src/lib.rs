@@ -13,4 +13,5 @@ pub mod native;
 pub mod params;
 pub mod profile;
 pub mod profiles;
+pub mod resume;
 pub mod supervisors;

@@ -1,10 +1,12 @@
 //! `robot-agent`: one robot's process. Loads and checks its controller before the first tick, so every startup
 //! failure (unknown controller or profile, bad supervisor file, unbound event, bad parameter) exits non-zero with
 //! the reason for the launcher to report; then joins the run and answers every tick: wait for the frame, step
-//! the controller, send the command.
+//! the controller, send the command. A restarted agent (`--resume`) continues from the world's record
+//! ([`robot_agent::resume`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 use clap::Parser;
@@ -12,9 +14,11 @@ use robot_agent::control::{self, Control};
 use robot_agent::controller::{self, Plan};
 use robot_agent::from_config;
 use robot_agent::params::Params;
+use robot_agent::resume::Resumer;
 use swarm_runtime::config::Experiment;
+use swarm_runtime::launcher::resume::ResumePoint;
 use swarm_runtime::messages::ActuatorCommand;
-use swarm_runtime::transport::{AgentLink, RunSpec};
+use swarm_runtime::transport::{AgentLink, RunSpec, TransportError};
 use tracing::{debug, info};
 
 /// One robot of a swarm run.
@@ -68,6 +72,9 @@ struct Args {
     /// controller).
     #[arg(long = "write-supervisors", requires = "check")]
     write_supervisors: Option<PathBuf>,
+    /// Resume point of a restarted robot (written by the world): the supervisors continue from it.
+    #[arg(long)]
+    resume: Option<PathBuf>,
 }
 
 fn parse_param(s: &str) -> Result<(String, String), String> {
@@ -139,10 +146,34 @@ fn write_supervisors(plan: &Plan, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// How long a replacement agent keeps trying to join while the world frees its dead predecessor's ports.
+const JOIN_RETRY: Duration = Duration::from_secs(10);
+/// Pause between two attempts to join.
+const JOIN_RETRY_PAUSE: Duration = Duration::from_millis(20);
+
+/// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports of the
+/// agent it replaces (iceoryx2 offers no notification of that), so a full service is retried for a while.
+fn join(run: &RunSpec, robot: u32) -> Result<AgentLink> {
+    let started = Instant::now();
+    loop {
+        match AgentLink::join(run, robot) {
+            Err(TransportError::ServiceFull { .. }) if started.elapsed() < JOIN_RETRY => {
+                std::thread::sleep(JOIN_RETRY_PAUSE);
+            }
+            other => return Ok(other?),
+        }
+    }
+}
+
 /// Answers every tick of the run until the world ends it.
 fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<()> {
+    let point = match &args.resume {
+        Some(path) => Some(ResumePoint::read(path)?),
+        None => None,
+    };
+    let mut resumer = Resumer::new(point);
     let run = RunSpec::new(&args.run, root)?;
-    let mut link = AgentLink::join(&run, args.robot)?;
+    let mut link = join(&run, args.robot)?;
     info!(
         run = args.run.as_str(),
         robot = args.robot,
@@ -151,7 +182,11 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
     let mut command = ActuatorCommand::idle(args.robot, 0);
     while let Some(tick) = link.next_tick().context("waiting for a tick")? {
-        control.step(tick.frame(), &mut command);
+        if resumer.before_step(control, tick.frame())? {
+            control.step(tick.frame(), &mut command);
+        } else {
+            command.events_len = 0;
+        }
         link.answer(tick, &command).context("answering a tick")?;
     }
     info!(robot = args.robot, "the world ended the run");

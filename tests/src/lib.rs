@@ -133,3 +133,53 @@ pub fn assert_clean(outcome: &SwarmOutcome) {
         "shared memory outlived the run"
     );
 }
+
+/// iceoryx2 root directories (`$TMPDIR/iceoryx2-<run>`) left by runs whose name starts with `run_prefix`.
+pub fn iceoryx_root_leftovers(run_prefix: &str) -> Vec<PathBuf> {
+    let prefix = format!("iceoryx2-{run_prefix}");
+    std::fs::read_dir(std::env::temp_dir())
+        .map(|entries| {
+            entries
+                .flatten()
+                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+                .map(|e| e.path())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Asserts that the runs of the launcher with process id `pid` left no process, no shared-memory file and no
+/// iceoryx2 root directory, whatever was killed during them.
+pub fn assert_nothing_left(pid: u32) {
+    let prefix = format!("sw{pid:x}-");
+    assert_eq!(
+        process_leftovers(&prefix),
+        Vec::<u32>::new(),
+        "processes outlived the run"
+    );
+    assert_eq!(
+        shm_leftovers(&prefix),
+        Vec::<PathBuf>::new(),
+        "shared memory outlived the run"
+    );
+    assert_eq!(
+        iceoryx_root_leftovers(&prefix),
+        Vec::<PathBuf>::new(),
+        "iceoryx2 files outlived the run"
+    );
+}
+
+/// Starts `swarm <args>` with the test-built programs and returns it running, standard error piped (for tests
+/// that talk to a live run).
+pub fn spawn_swarm(args: &[&str]) -> std::process::Child {
+    let dir = bin_dir();
+    Command::new(dir.join("swarm"))
+        .args(args)
+        .env("SWARM_BIN_DIR", dir)
+        .env("RUST_LOG", "info")
+        .current_dir(workspace_root())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("swarm starts")
+}

@@ -3,6 +3,8 @@
 //! `swarm run <config.argos>` starts the world and one agent process per robot, shows progress, and leaves the
 //! run directory (summary, trajectories, events, snapshot, logs). Ctrl-C stops the run cleanly: the world finishes
 //! its tick and flushes its records, and every process and shared-memory file of the run is removed.
+//! `swarm run --fault "kill robots=3 tick=50"` adds faults to the configuration's `<faults>`, and
+//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot>` drives a live run (docs/faults.md).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -13,6 +15,7 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use swarm_runtime::bench::BenchOptions;
+use swarm_runtime::launcher::control::{self, CtlCommand};
 use swarm_runtime::launcher::{self, RunOptions};
 
 /// Runs swarms of robot processes executing ptSCT supervisors.
@@ -51,10 +54,43 @@ enum Commands {
         /// every tick kept its slot.
         #[arg(long)]
         real_time: bool,
+        /// A fault added to the configuration's <faults>, as the element in words (repeatable), e.g.
+        /// "kill robots=3 tick=50", "chaos every=2 count=1", "restart policy=on-failure max_restarts=2".
+        #[arg(long = "fault", value_name = "FAULT")]
+        faults: Vec<String>,
+    },
+    /// Drive a live run from another terminal: list its robots, kill, freeze or thaw one.
+    Ctl {
+        /// The run directory of the live run (its `--out`), or its control socket.
+        run: PathBuf,
+        #[command(subcommand)]
+        request: CtlRequestArg,
     },
     /// Benchmark: the whole system at ARGoS' obstacle-avoidance density (one process per robot), the bare
     /// lockstep transport, and a real-time check; prints Markdown tables and writes <out>/bench.json.
     Bench(BenchArgs),
+}
+
+/// What `swarm ctl` asks a live run.
+#[derive(Debug, Subcommand)]
+enum CtlRequestArg {
+    /// Every robot with its agent's process id, state and restarts.
+    List,
+    /// SIGKILL a robot's agent (it is restarted if its restart policy says so).
+    Kill {
+        /// Robot index.
+        robot: u32,
+    },
+    /// SIGSTOP a robot's agent; the world stops waiting for it after one tick deadline.
+    Freeze {
+        /// Robot index.
+        robot: u32,
+    },
+    /// SIGCONT a frozen robot's agent; it takes part again from the tick after its next answer.
+    Thaw {
+        /// Robot index.
+        robot: u32,
+    },
 }
 
 /// Flags of `swarm bench`.
@@ -147,6 +183,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             tick_deadline_ms,
             no_progress,
             real_time,
+            faults,
         } => {
             let stop = Arc::new(AtomicBool::new(false));
             let flag = Arc::clone(&stop);
@@ -161,6 +198,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 progress: !no_progress,
                 tick_deadline: tick_deadline_ms.map(Duration::from_millis),
                 real_time,
+                faults,
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;
@@ -169,7 +207,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let steps = f64::from(report.robots) * report.ticks as f64;
             println!(
                 "{} after {} ticks: {} robots, seed {}, {:.1} s ({:.2} s to the first tick), {:.0} robot-steps/s, \
-                 {} deaths; records in {}",
+                 {} deaths, {} faults, {} alive; records in {}",
                 if report.interrupted {
                     "stopped"
                 } else {
@@ -182,9 +220,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 report.time_to_first_tick_seconds,
                 steps / ticking,
                 report.deaths.len(),
+                report.faults.len(),
+                report.alive_final,
                 report.out_dir.display()
             );
             Ok(())
         }
+        Commands::Ctl { run, request } => ctl(&run, request),
     }
+}
+
+/// `swarm ctl`: one request to a live run, its answer on standard output.
+fn ctl(run: &std::path::Path, request: CtlRequestArg) -> anyhow::Result<()> {
+    let command = match request {
+        CtlRequestArg::List => CtlCommand::List,
+        CtlRequestArg::Kill { robot } => CtlCommand::Kill(robot),
+        CtlRequestArg::Freeze { robot } => CtlCommand::Freeze(robot),
+        CtlRequestArg::Thaw { robot } => CtlCommand::Thaw(robot),
+    };
+    let answer = control::request(run, command)
+        .with_context(|| format!("swarm ctl {} {command}", run.display()))?;
+    print!("{answer}");
+    Ok(())
 }

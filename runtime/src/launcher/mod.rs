@@ -9,11 +9,25 @@
 //! for N robots and says `ready`) -> start the agents -> follow the world's tick reports on a progress bar; an agent
 //! that dies is reported to the world at once on its standard input (`dead <robot>`) -> when the world says
 //! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory.
+//!
+//! Faults (docs/faults.md): the world paces the schedule and reports each due fault between two ticks; the
+//! launcher applies it to the processes ([`fault_handling`]), restarts agents by their [`restart`] policy, and
+//! takes `swarm ctl` requests on the run's [`control`] socket. If the world dies, the launcher stops every agent,
+//! cuts the records back to the last complete tick ([`records`]), writes the summary and fails with the reason.
 
+mod agents;
 pub mod binaries;
 mod children;
+pub mod control;
+mod fault_handling;
+pub mod fault_log;
+pub mod faults;
 pub mod process_args;
+pub mod records;
+pub mod restart;
+pub mod resume;
 pub mod run_dir;
+pub mod world_control;
 pub mod world_report;
 
 use std::collections::HashMap;
@@ -28,11 +42,17 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use indicatif::{ProgressBar, ProgressStyle};
 use nix::sys::signal::Signal;
 
+use crate::config::faults::{FaultKind, FaultSchedule};
 use crate::config::{ConfigErrors, Experiment};
 use crate::transport::RunSpec;
+use agents::{AgentSpawner, RobotEntry};
 use binaries::{Binaries, BinariesError};
 use children::Children;
+use control::ControlServer;
+use fault_log::FaultRecord;
+use faults::FaultPlan;
 use process_args::{AgentArgs, RunArgs, WorldArgs};
+use restart::RestartTracker;
 use world_report::WorldReport;
 
 /// How long the launcher waits for the world to create its services.
@@ -63,6 +83,8 @@ pub struct RunOptions {
     pub tick_deadline: Option<Duration>,
     /// Pace the ticks at the configuration's ticks_per_second (real-time mode) instead of running flat out.
     pub real_time: bool,
+    /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
+    pub faults: Vec<String>,
 }
 
 /// What a finished run reports.
@@ -88,6 +110,10 @@ pub struct RunReport {
     pub world_pid: u32,
     /// Process id of each robot's (first) agent, by robot index.
     pub agent_pids: Vec<u32>,
+    /// Every fault of the run, in the order the launcher learnt of them.
+    pub faults: Vec<FaultRecord>,
+    /// Robots taking part when the run ended.
+    pub alive_final: u32,
 }
 
 /// An agent that died while the run went on.
@@ -207,6 +233,19 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         iox_root: spec.root_dir().to_path_buf(),
     };
     let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
+    let controller_ids: Vec<&str> = experiment
+        .controllers
+        .iter()
+        .map(|c| c.id.as_str())
+        .collect();
+    let schedule = FaultSchedule::load(&options.config, &options.faults, robots, &controller_ids)?;
+    let ticks_per_second = experiment.framework.ticks_per_second;
+    let mut startup = Vec::new();
+    FaultPlan::new(&schedule, ticks_per_second, seed).due(
+        0,
+        &vec![true; roster.len()],
+        &mut startup,
+    );
     tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
 
     let compiled = check_controllers(
@@ -231,6 +270,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
         join_timeout_ms: 120_000,
         real_time: options.real_time,
+        faults: options.faults.clone(),
     };
     let mut world = children::spawn(
         Command::new(&binaries.world)
@@ -245,37 +285,25 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     children.world = Some(world);
 
     wait_ready(&mut children, &reports, robots)?;
-    children.agents.reserve(roster.len());
-    for (robot, entry) in roster.iter().enumerate() {
-        let agent_args = AgentArgs {
-            run: run_args.clone(),
-            robot: robot as u32,
-            config: config.clone(),
-            controller: entry.epuck.controller.clone(),
-            seed,
-            robots: options.robots,
-            compiled_supervisors: compiled.get(&entry.epuck.controller).cloned(),
-        };
-        let log_path = run_dir::agent_log(&out_dir, robot as u32);
-        let log = std::fs::File::create(&log_path)
-            .map_err(io(format!("creating {}", log_path.display())))?;
-        let child = children::spawn(
-            Command::new(&binaries.agent)
-                .args(agent_args.to_args())
-                .stdin(Stdio::null())
-                .stdout(Stdio::null())
-                .stderr(log),
-        )
-        .map_err(io(format!("starting {}", binaries.agent.display())))?;
-        children.agents.push(Some(child));
-    }
-
-    let agent_pids: Vec<u32> = children
-        .agents
-        .iter()
-        .flatten()
-        .map(std::process::Child::id)
-        .collect();
+    let control = match ControlServer::listen(&out_dir) {
+        Ok(server) => Some(server),
+        Err(e) => {
+            tracing::warn!(
+                "no `swarm ctl` for this run: cannot listen in {}: {e}",
+                out_dir.display()
+            );
+            None
+        }
+    };
+    let spawner = AgentSpawner {
+        program: binaries.agent.clone(),
+        run: run_args.clone(),
+        config: config.clone(),
+        seed,
+        robots: options.robots,
+        out_dir: out_dir.clone(),
+        compiled,
+    };
     let progress = progress_bar(options.progress, ticks, robots);
     let mut supervision = Supervision {
         children,
@@ -288,26 +316,42 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         last_tick: 0,
         deaths: Vec::new(),
         interrupted: false,
+        robots: roster
+            .iter()
+            .map(|r| {
+                RobotEntry::new(
+                    r.epuck.controller.clone(),
+                    RestartTracker::new(
+                        schedule.restart_rule(r.index, &r.epuck.controller).cloned(),
+                    ),
+                )
+            })
+            .collect(),
+        spawner,
+        ticks_per_second,
+        faults: Vec::new(),
+        pending_restarts: Vec::new(),
+        control,
     };
-    supervision.follow(&reports, &stop)?;
+    supervision.start_agents(&startup)?;
+    let agent_pids: Vec<u32> = supervision.robots.iter().map(|r| r.first_pid).collect();
+    let followed = supervision.follow(&reports, &stop);
+    if let Err(error) = followed {
+        supervision.children.kill_all();
+        supervision.progress.finish_and_clear();
+        if matches!(error, LaunchError::WorldDied { .. }) {
+            let complete = records::trim_to_complete_ticks(&out_dir, robots)
+                .map_err(io("cutting the records back to the last complete tick"))?;
+            let report =
+                supervision.report(seed, robots, world_pid, agent_pids, complete.unwrap_or(0));
+            complete_summary(&out_dir, &report, Some(&error.to_string()))?;
+        }
+        return Err(error);
+    }
     supervision.collect_agents();
     supervision.progress.finish_and_clear();
-
-    let report = RunReport {
-        out_dir: out_dir.clone(),
-        seed,
-        robots,
-        ticks: supervision.last_tick,
-        wall_seconds: started.elapsed().as_secs_f64(),
-        time_to_first_tick_seconds: supervision
-            .first_tick
-            .map_or(0.0, |t| t.duration_since(started).as_secs_f64()),
-        interrupted: supervision.interrupted,
-        deaths: supervision.deaths.clone(),
-        world_pid,
-        agent_pids,
-    };
-    complete_summary(&out_dir, &report)?;
+    let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
+    complete_summary(&out_dir, &report, None)?;
     Ok(report)
 }
 
@@ -349,6 +393,7 @@ fn check_controllers(
             seed,
             robots,
             compiled_supervisors: None,
+            resume: None,
         };
         let compiled_file = compiled_dir.join(format!("{controller}.ptsct"));
         let output = Command::new(&binaries.agent)
@@ -475,10 +520,19 @@ struct Supervision {
     last_tick: u64,
     deaths: Vec<Death>,
     interrupted: bool,
+    /// Per robot: its agent's process, state and restart history.
+    robots: Vec<RobotEntry>,
+    spawner: AgentSpawner,
+    ticks_per_second: u32,
+    faults: Vec<FaultRecord>,
+    /// Replacement agents to start once their backoff has passed (robot, when).
+    pending_restarts: Vec<(u32, Instant)>,
+    control: Option<ControlServer>,
 }
 
 impl Supervision {
-    /// Follows the run until the world finishes (or is stopped and finishes), handling deaths on the way.
+    /// Follows the run until the world finishes (or is stopped and finishes), handling deaths, faults,
+    /// restarts and `swarm ctl` requests on the way.
     fn follow(
         &mut self,
         reports: &Receiver<WorldReport>,
@@ -490,6 +544,7 @@ impl Supervision {
                 stop_sent = true;
                 self.interrupted = true;
                 tracing::info!("stopping: the world finishes its tick and flushes its records");
+                self.thaw_all();
                 if let Some(world) = &self.children.world {
                     children::signal(world, Signal::SIGTERM);
                 }
@@ -513,6 +568,17 @@ impl Supervision {
                     self.wait_world()?;
                     return Ok(());
                 }
+                Ok(WorldReport::Fault { tick, kind, robot }) => {
+                    self.on_fault(tick, kind, robot)?;
+                    if kind == FaultKind::KillWorld {
+                        return self.world_killed(tick);
+                    }
+                }
+                Ok(WorldReport::Await { tick }) => {
+                    self.send_world(world_control::WorldCommand::Applied(tick))
+                }
+                Ok(WorldReport::Down { tick, robot, cause }) => self.on_down(tick, robot, cause),
+                Ok(WorldReport::Up { tick, robot }) => self.on_up(tick, robot),
                 Ok(WorldReport::Ready { .. }) | Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => {
                     // The world closed its output: it is exiting; its status says how.
@@ -524,6 +590,15 @@ impl Supervision {
                 }
             }
             self.handle_agent_exits()?;
+            self.start_due_restarts()?;
+            self.answer_control();
+        }
+    }
+
+    /// Sends one line to the world (a world that is gone is noticed by the report loop).
+    fn send_world(&mut self, command: world_control::WorldCommand) {
+        if let Some(stdin) = self.world_stdin.as_mut() {
+            let _ = writeln!(stdin, "{command}");
         }
     }
 
@@ -531,7 +606,7 @@ impl Supervision {
     /// death the world hears of at once (a successful one means the world already ended the run).
     fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
         for (robot, status) in self.children.reap_agents() {
-            if self.first_tick.is_none() {
+            if self.first_tick.is_none() && !self.robots[robot as usize].ctl_killed {
                 let log =
                     run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
                 return Err(LaunchError::AgentFailed {
@@ -550,14 +625,13 @@ impl Supervision {
                 continue;
             }
             tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
-            if let Some(stdin) = self.world_stdin.as_mut() {
-                let _ = writeln!(stdin, "dead {robot}");
-            }
+            self.send_world(world_control::WorldCommand::Dead(robot));
             self.deaths.push(Death {
                 robot,
                 after_tick: self.last_tick,
                 status: status.to_string(),
             });
+            self.on_exit(robot, status.to_string());
         }
         Ok(())
     }
@@ -580,6 +654,7 @@ impl Supervision {
 
     /// Lets agents exit by themselves (the world's end tells them), then kills the rest.
     fn collect_agents(&mut self) {
+        self.thaw_all();
         let deadline = Instant::now() + AGENT_EXIT_GRACE;
         while self.children.agents_running() > 0 && Instant::now() < deadline {
             self.children.reap_agents();
@@ -594,10 +669,42 @@ impl Supervision {
         }
         self.children.kill_all();
     }
+
+    /// What the run did, for `summary.json` and the caller.
+    fn report(
+        &self,
+        seed: u64,
+        robots: u32,
+        world_pid: u32,
+        agent_pids: Vec<u32>,
+        ticks: u64,
+    ) -> RunReport {
+        RunReport {
+            out_dir: self.out_dir.clone(),
+            seed,
+            robots,
+            ticks,
+            wall_seconds: self.started.elapsed().as_secs_f64(),
+            time_to_first_tick_seconds: self
+                .first_tick
+                .map_or(0.0, |t| t.duration_since(self.started).as_secs_f64()),
+            interrupted: self.interrupted,
+            deaths: self.deaths.clone(),
+            world_pid,
+            agent_pids,
+            faults: self.faults.clone(),
+            alive_final: self.robots.iter().filter(|r| r.is_alive()).count() as u32,
+        }
+    }
 }
 
-/// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none).
-fn complete_summary(out_dir: &Path, report: &RunReport) -> Result<(), LaunchError> {
+/// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none, e.g. because
+/// it died: `world_died` then says why).
+fn complete_summary(
+    out_dir: &Path,
+    report: &RunReport,
+    world_died: Option<&str>,
+) -> Result<(), LaunchError> {
     let path = out_dir.join("summary.json");
     let mut summary = std::fs::read_to_string(&path)
         .ok()
@@ -624,6 +731,15 @@ fn complete_summary(out_dir: &Path, report: &RunReport) -> Result<(), LaunchErro
             "processes".into(),
             serde_json::json!({"world": report.world_pid, "agents": report.agent_pids}),
         );
+        let faults: Vec<serde_json::Value> =
+            report.faults.iter().map(FaultRecord::to_json).collect();
+        object.insert("faults".into(), faults.into());
+        object
+            .entry("alive_final")
+            .or_insert(report.alive_final.into());
+        if let Some(reason) = world_died {
+            object.insert("world_died".into(), reason.into());
+        }
     }
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     std::fs::write(&path, text + "\n").map_err(io(format!("writing {}", path.display())))

@@ -62,6 +62,9 @@ pub struct WorldArgs {
     /// Pace the ticks at the configuration's ticks_per_second instead of running as fast as possible.
     #[arg(long = "real-time")]
     pub real_time: bool,
+    /// Faults given on the command line (`swarm run --fault`), added to the configuration's `<faults>`.
+    #[arg(long = "fault")]
+    pub faults: Vec<String>,
 }
 
 impl WorldArgs {
@@ -88,6 +91,9 @@ impl WorldArgs {
         }
         if self.real_time {
             args.push("--real-time".into());
+        }
+        for fault in &self.faults {
+            args.extend(["--fault".into(), fault.clone()]);
         }
         args
     }
@@ -118,6 +124,9 @@ pub struct AgentArgs {
     /// `supervisors` parameter, so N agents do not synthesise the same models N times.
     #[arg(long = "compiled-supervisors")]
     pub compiled_supervisors: Option<PathBuf>,
+    /// A restarted agent's resume point (`launcher::resume`): its supervisors continue from it.
+    #[arg(long)]
+    pub resume: Option<PathBuf>,
 }
 
 impl AgentArgs {
@@ -139,6 +148,9 @@ impl AgentArgs {
         }
         if let Some(file) = &self.compiled_supervisors {
             args.extend(["--compiled-supervisors".into(), file.display().to_string()]);
+        }
+        if let Some(resume) = &self.resume {
+            args.extend(["--resume".into(), resume.display().to_string()]);
         }
         args
     }
@@ -181,6 +193,7 @@ mod tests {
             tick_deadline_ms: Some(250),
             join_timeout_ms: 5_000,
             real_time: true,
+            faults: vec!["kill robots=3 tick=50".into()],
         };
         let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
         assert_eq!(World::parse_from(line).args, args);
@@ -196,6 +209,7 @@ mod tests {
             seed: 124,
             robots: Some(40),
             compiled_supervisors: Some(PathBuf::from("runs/x/supervisors/fdc.ptsct")),
+            resume: Some(PathBuf::from("runs/x/resume/robot-7.json")),
         };
         let line = std::iter::once("robot-agent".to_string()).chain(args.to_args());
         assert_eq!(Agent::parse_from(line).args, args);

@@ -1,10 +1,15 @@
 //! The world process's progress reports to the launcher: one line each on the world's standard output.
 //!
 //! Lines are plain text so a person can read them when starting the world by hand:
-//! `ready 40`, `tick 120 answered 39 missing 0 dead 1`, `finished 600`. Anything else on the world's standard
-//! output is ignored by the launcher.
+//! `ready 40`, `tick 120 answered 39 missing 0 dead 1`, `finished 600`, and for faults `fault 50 kill 3`
+//! (a scheduled fault is due; after the last one of a tick, `await 50`: the world waits for the launcher's
+//! `applied 50`), `down 51 3 notice` (the world
+//! marked robot 3 dead at tick 51) and `up 80 3` (robot 3 takes part again from tick 80). Anything else on the
+//! world's standard output is ignored by the launcher.
 
 use std::fmt;
+
+use crate::config::faults::FaultKind;
 
 /// One progress report of the world process.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,6 +35,55 @@ pub enum WorldReport {
         /// Ticks run.
         ticks: u64,
     },
+    /// A scheduled fault is due before `tick`; the world has recorded it and waits for `applied <tick>`.
+    Fault {
+        /// The tick it happens at.
+        tick: u64,
+        /// What happens.
+        kind: FaultKind,
+        /// The robot, or `None` for the world itself.
+        robot: Option<u32>,
+    },
+    /// Every fault due at `tick` has been reported; the world waits for `applied <tick>`.
+    Await {
+        /// The tick.
+        tick: u64,
+    },
+    /// The world marked a robot dead from `tick` on (outside the schedule) and wrote its resume point.
+    Down {
+        /// First tick without the robot.
+        tick: u64,
+        /// The robot.
+        robot: u32,
+        /// How the world learnt of it.
+        cause: DownCause,
+    },
+    /// A robot takes part again from `tick` on (restarted, thawed or answering again).
+    Up {
+        /// First tick with the robot.
+        tick: u64,
+        /// The robot.
+        robot: u32,
+    },
+}
+
+/// How the world learnt that a robot is gone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DownCause {
+    /// The launcher's death notice (the OS reported the process ended).
+    Notice,
+    /// The robot missed a tick's deadline (frozen, hung, or gone without a notice).
+    Deadline,
+}
+
+impl DownCause {
+    /// The word on the report line.
+    pub fn name(self) -> &'static str {
+        match self {
+            DownCause::Notice => "notice",
+            DownCause::Deadline => "deadline",
+        }
+    }
 }
 
 impl fmt::Display for WorldReport {
@@ -46,6 +100,15 @@ impl fmt::Display for WorldReport {
                 "tick {tick} answered {answered} missing {missing} dead {dead}"
             ),
             WorldReport::Finished { ticks } => write!(f, "finished {ticks}"),
+            WorldReport::Fault { tick, kind, robot } => match robot {
+                Some(robot) => write!(f, "fault {tick} {} {robot}", kind.name()),
+                None => write!(f, "fault {tick} {} world", kind.name()),
+            },
+            WorldReport::Down { tick, robot, cause } => {
+                write!(f, "down {tick} {robot} {}", cause.name())
+            }
+            WorldReport::Up { tick, robot } => write!(f, "up {tick} {robot}"),
+            WorldReport::Await { tick } => write!(f, "await {tick}"),
         }
     }
 }
@@ -76,6 +139,28 @@ impl WorldReport {
             ["finished", ticks] => Some(WorldReport::Finished {
                 ticks: ticks.parse().ok()?,
             }),
+            ["fault", tick, kind, robot] => Some(WorldReport::Fault {
+                tick: tick.parse().ok()?,
+                kind: FaultKind::from_name(kind)?,
+                robot: match *robot {
+                    "world" => None,
+                    r => Some(r.parse().ok()?),
+                },
+            }),
+            ["down", tick, robot, cause] => Some(WorldReport::Down {
+                tick: tick.parse().ok()?,
+                robot: robot.parse().ok()?,
+                cause: [DownCause::Notice, DownCause::Deadline]
+                    .into_iter()
+                    .find(|c| c.name() == *cause)?,
+            }),
+            ["await", tick] => Some(WorldReport::Await {
+                tick: tick.parse().ok()?,
+            }),
+            ["up", tick, robot] => Some(WorldReport::Up {
+                tick: tick.parse().ok()?,
+                robot: robot.parse().ok()?,
+            }),
             _ => None,
         }
     }
@@ -96,6 +181,23 @@ mod tests {
                 dead: 1,
             },
             WorldReport::Finished { ticks: 600 },
+            WorldReport::Fault {
+                tick: 50,
+                kind: FaultKind::Freeze,
+                robot: Some(3),
+            },
+            WorldReport::Fault {
+                tick: 90,
+                kind: FaultKind::KillWorld,
+                robot: None,
+            },
+            WorldReport::Down {
+                tick: 51,
+                robot: 3,
+                cause: DownCause::Deadline,
+            },
+            WorldReport::Up { tick: 80, robot: 3 },
+            WorldReport::Await { tick: 50 },
         ] {
             assert_eq!(WorldReport::parse(&report.to_string()), Some(report));
         }

@@ -97,6 +97,10 @@ impl AgentLink {
     }
 
     fn connect(run: &RunSpec, robot: u32, sync: &SyncBlock) -> Result<Ports, TransportError> {
+        if sync.is_dead(robot) {
+            // A replacement: the dead agent may still hold the writer slot of the robot's current board.
+            sync.request_board(robot);
+        }
         let waited = Instant::now();
         let generation =
             sync.wait_board(robot, waited + BOARD_WAIT)

@@ -115,7 +115,7 @@ pub enum TransportError {
     /// The world did not provide a command board for a replacement agent in time.
     #[error(
         "robot {robot} cannot join: the world has not replaced its command board after {waited_ms} ms \
-         (it does so at the first tick after the death notice)"
+         (it does so at its next tick)"
     )]
     NoCommandBoard {
         /// The robot index.

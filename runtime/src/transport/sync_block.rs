@@ -54,6 +54,8 @@ struct Header {
     joined: Line32,
     /// Non-zero once the world ends the run.
     stop: Line32,
+    /// Count of replacement agents' requests for a fresh command board; the world polls it once per tick.
+    board_requests: Line32,
 }
 
 /// Per-robot control words.
@@ -331,15 +333,29 @@ impl SyncBlock {
     pub(crate) fn mark_dead(&self, robot: u32) {
         let slot = self.slot(robot);
         slot.dead.store(1, Ordering::SeqCst);
-        slot.board.store(0, Ordering::SeqCst);
         if slot.owner.swap(0, Ordering::AcqRel) == 1 {
             self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
         }
         self.claim(robot, self.header().tick.load(Ordering::SeqCst));
     }
 
-    /// Whether `robot`'s command board awaits replacement after a death notice.
-    pub(crate) fn board_retired(&self, robot: u32) -> bool {
+    /// A replacement agent for `robot` asks for a fresh command board: its dead predecessor may still hold the
+    /// current board's single writer slot.
+    pub(crate) fn request_board(&self, robot: u32) {
+        self.slot(robot).board.store(0, Ordering::SeqCst);
+        let header = self.header();
+        header.board_requests.0.fetch_add(1, Ordering::AcqRel);
+        // A world waiting for agents sleeps on the join word: wake it to serve the request.
+        futex::wake(&header.joined.0, 1);
+    }
+
+    /// Number of fresh command boards requested so far.
+    pub(crate) fn board_requests(&self) -> u32 {
+        self.header().board_requests.0.load(Ordering::Acquire)
+    }
+
+    /// Whether `robot`'s replacement agent waits for a fresh command board.
+    pub(crate) fn board_requested(&self, robot: u32) -> bool {
         self.slot(robot).board.load(Ordering::Acquire) == 0
     }
 
@@ -370,6 +386,28 @@ impl SyncBlock {
     /// Whether `robot` has a death notice and no replacement yet.
     pub(crate) fn is_dead(&self, robot: u32) -> bool {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
+    }
+
+    /// Whether `robot` has a connected agent and no death notice.
+    pub(crate) fn has_agent(&self, robot: u32) -> bool {
+        let slot = self.slot(robot);
+        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
+    }
+
+    /// Withdraws a death notice for a robot whose agent is still connected (it was frozen, or late): it owns
+    /// the robot again and ticks wait for it again. `false` if another agent claimed the robot meanwhile.
+    pub(crate) fn revive(&self, robot: u32) -> bool {
+        let slot = self.slot(robot);
+        if slot
+            .owner
+            .compare_exchange(0, 1, Ordering::AcqRel, Ordering::Acquire)
+            .is_err()
+        {
+            return false;
+        }
+        slot.dead.store(0, Ordering::SeqCst);
+        self.header().joined.0.fetch_add(1, Ordering::AcqRel);
+        true
     }
 
     /// An agent claims `robot` before it connects, so that a second agent for the same robot fails fast.
@@ -410,21 +448,20 @@ impl SyncBlock {
         }
     }
 
-    /// Waits until `count` agents have joined or `deadline` passes; returns the number joined.
+    /// Waits until `count` agents have joined, `deadline` passes, 100 ms pass, or someone wakes the join word
+    /// (an agent joining or asking for a command board); returns the number joined. Callers loop.
     pub(crate) fn wait_joined(&self, count: u32, deadline: Instant) -> u32 {
         let joined = &self.header().joined.0;
-        loop {
-            let current = joined.load(Ordering::Acquire);
-            let now = Instant::now();
-            if current >= count || now >= deadline {
-                return current;
-            }
+        let current = joined.load(Ordering::Acquire);
+        let now = Instant::now();
+        if current < count && now < deadline {
             futex::wait(
                 joined,
                 current,
                 Some((deadline - now).min(Duration::from_millis(100))),
             );
         }
+        joined.load(Ordering::Acquire)
     }
 
     /// Waits until the epoch word differs from `seen` (or the run stops), spinning `spin` times before blocking.

@@ -153,6 +153,7 @@ pub struct WorldLink {
     status: Vec<CommandStatus>,
     deaths: DeathNotices,
     notices_handled: u64,
+    board_requests_handled: u32,
     last_cleanup: u64,
     node: Node<ipc::Service>,
 }
@@ -183,6 +184,7 @@ impl WorldLink {
                 notices: Arc::new(AtomicU64::new(0)),
             },
             notices_handled: 0,
+            board_requests_handled: 0,
             last_cleanup: 0,
             node,
             config,
@@ -223,19 +225,36 @@ impl WorldLink {
         self.tick
     }
 
-    /// Blocks until every robot has an agent or `timeout` passes.
-    pub fn wait_for_agents(&self, timeout: Duration) -> Result<(), TransportError> {
+    /// Blocks until every robot has an agent or `timeout` passes, giving replacement agents that join meanwhile
+    /// their fresh command boards.
+    pub fn wait_for_agents(&mut self, timeout: Duration) -> Result<(), TransportError> {
         let start = Instant::now();
+        let deadline = start + timeout;
         let expected = self.config.robots;
-        let joined = self.deaths.sync.wait_joined(expected, start + timeout);
-        if joined >= expected {
-            Ok(())
-        } else {
-            Err(TransportError::JoinTimeout {
-                joined,
-                expected,
-                waited_ms: start.elapsed().as_millis(),
-            })
+        loop {
+            self.serve_board_requests();
+            let joined = self.deaths.sync.wait_joined(expected, deadline);
+            if joined >= expected {
+                return Ok(());
+            }
+            if Instant::now() >= deadline {
+                return Err(TransportError::JoinTimeout {
+                    joined,
+                    expected,
+                    waited_ms: start.elapsed().as_millis(),
+                });
+            }
+        }
+    }
+
+    /// Renews the command boards replacement agents asked for, after removing dead agents' iceoryx2 resources.
+    fn serve_board_requests(&mut self) {
+        let requests = self.deaths.sync.board_requests();
+        if requests != self.board_requests_handled {
+            self.board_requests_handled = requests;
+            let state = self.node.try_cleanup_dead_nodes();
+            tracing::debug!(?state, "dead-node cleanup for a replacement agent");
+            self.renew_requested_boards();
         }
     }
 
@@ -247,6 +266,18 @@ impl WorldLink {
     /// Death notice from the world's own thread; see [`DeathNotices::mark_dead`].
     pub fn mark_dead(&self, robot: u32) -> Result<(), TransportError> {
         self.deaths.mark_dead(robot)
+    }
+
+    /// Whether `robot` has a connected agent without a death notice (e.g. a replacement agent has joined).
+    pub fn agent_present(&self, robot: u32) -> bool {
+        robot < self.config.robots && self.deaths.sync.has_agent(robot)
+    }
+
+    /// Withdraws the death notice of `robot`, whose agent is still connected (thawed, or answering again after
+    /// missing deadlines): from the next tick on, ticks wait for it again. `false` when the robot is out of
+    /// range or another agent has claimed it meanwhile.
+    pub fn revive(&self, robot: u32) -> bool {
+        robot < self.config.robots && self.deaths.sync.revive(robot)
     }
 
     /// Runs one tick: `sense` fills every robot's frame (pre-set to [`SensorFrame::empty`] with this tick;
@@ -314,6 +345,7 @@ impl WorldLink {
     }
 
     fn cleanup_if_due(&mut self, tick: u64) {
+        self.serve_board_requests();
         let notices = self.deaths.notices.load(Ordering::Acquire);
         if notices != self.notices_handled
             || tick - self.last_cleanup >= self.config.cleanup_interval
@@ -322,15 +354,14 @@ impl WorldLink {
             self.last_cleanup = tick;
             let state = self.node.try_cleanup_dead_nodes();
             tracing::debug!(tick, ?state, "dead-node cleanup");
-            self.renew_retired_boards();
         }
     }
 
-    /// Gives every robot with a death notice a fresh command board for its replacement agent.
-    fn renew_retired_boards(&mut self) {
+    /// Gives every robot whose replacement agent asked for one a fresh command board.
+    fn renew_requested_boards(&mut self) {
         let sync = &self.deaths.sync;
         for (robot, board) in (0..).zip(self.boards.commands.iter_mut()) {
-            if !sync.board_retired(robot) {
+            if !sync.board_requested(robot) {
                 continue;
             }
             let generation = board.generation + 1;

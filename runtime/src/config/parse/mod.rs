@@ -42,13 +42,24 @@ pub(crate) struct Ctx {
 }
 
 impl Ctx {
-    fn new(path: &Path) -> Self {
+    /// A fresh context for the file at `path`.
+    pub(crate) fn new(path: &Path) -> Self {
         Self {
             path: path.to_path_buf(),
             errors: Vec::new(),
             warnings: Vec::new(),
             medium_refs: Vec::new(),
         }
+    }
+
+    /// The file being read.
+    pub(crate) fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The errors found (warnings are dropped).
+    pub(crate) fn into_errors(self) -> Vec<Diagnostic> {
+        self.errors
     }
 
     /// Records an error with an optional hint.
@@ -248,6 +259,7 @@ const SECTIONS: &[&str] = &[
     "physics_engines",
     "media",
     "visualization",
+    super::faults::SECTION,
 ];
 
 /// The root element and its sections.
@@ -312,6 +324,9 @@ fn experiment(ctx: &mut Ctx, root: &Element, path: &Path) -> Option<Experiment> 
     };
     if let Some(el) = section("visualization") {
         visualization(ctx, el);
+    }
+    if let Some(el) = section(super::faults::SECTION) {
+        super::faults::check_section(ctx, el);
     }
     Some(Experiment {
         path: path.to_path_buf(),

@@ -2,7 +2,8 @@
 //!
 //! Event ids are global per controller's supervisor set; names come from the event tables the launcher wrote
 //! into the run directory (`event_tables.json`: controller id -> event names by id). Rows are buffered and
-//! flushed at the end of every tick, so a crash loses at most the tick being written.
+//! flushed at the end of every tick, so a crash loses at most the tick being written. Faults are rows too, with
+//! `fault:<what>` in the event column (docs/faults.md).
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -61,6 +62,12 @@ impl EventsWriter {
             }
         }
         Ok(())
+    }
+
+    /// Writes a fault row: `name` (e.g. `fault:kill`) in the event column, taking effect at `tick`.
+    pub fn record_fault(&mut self, tick: u64, robot: usize, name: &str) -> std::io::Result<()> {
+        let id = self.robots.get(robot).map_or("", |(id, _)| id.as_str());
+        writeln!(self.out, "{tick},{robot},{id},{name}")
     }
 
     /// Ends a tick: everything recorded so far reaches the file.

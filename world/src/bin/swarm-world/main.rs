@@ -3,32 +3,33 @@
 //! Builds the arena from the experiment, creates the run's shared-memory services for N robots, says `ready`,
 //! waits for the agents, then runs the lockstep: sense every robot into the shared frames, wake the agents, wait
 //! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
-//! Progress goes to standard output as [`WorldReport`] lines for the launcher; `dead <robot>` lines on standard
-//! input are the launcher's death notices. SIGINT/SIGTERM end the run after the current tick with every record
+//! Progress goes to standard output as [`WorldReport`] lines for the launcher; the launcher's lines on standard
+//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`]. SIGINT/SIGTERM end the run after the current tick with every record
 //! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`.
 
 mod events;
+mod faults;
 mod pacing;
 
-use std::io::{BufRead, Write};
+use std::io::Write;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
 use swarm_runtime::config::Experiment;
+use swarm_runtime::config::faults::FaultSchedule;
 use swarm_runtime::launcher::process_args::WorldArgs;
 use swarm_runtime::launcher::world_report::WorldReport;
 use swarm_runtime::messages::ActuatorCommand;
-use swarm_runtime::transport::{DeathNotices, LinkConfig, RunSpec, WorldLink};
+use swarm_runtime::transport::{LinkConfig, RunSpec, WorldLink};
 use swarm_world::World;
-use swarm_world::entities::RobotId;
 use swarm_world::recorder::Recorder;
 
 use events::EventsWriter;
+use faults::FaultDriver;
 use pacing::Pacer;
 
 /// Minimum interval between two progress reports to the launcher.
@@ -60,31 +61,6 @@ fn report(line: WorldReport) {
     let _ = out.flush();
 }
 
-/// Forwards the launcher's `dead <robot>` lines to the transport at once (so the current tick stops waiting) and
-/// to the main loop (which turns the robot into an inert body between ticks).
-fn follow_death_notices(notices: DeathNotices) -> Receiver<u32> {
-    let (sender, receiver) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in std::io::stdin().lock().lines() {
-            let Ok(line) = line else { break };
-            let Some(robot) = line
-                .strip_prefix("dead ")
-                .and_then(|r| r.trim().parse::<u32>().ok())
-            else {
-                continue;
-            };
-            if let Err(e) = notices.mark_dead(robot) {
-                tracing::warn!("ignoring death notice '{line}': {e}");
-                continue;
-            }
-            if sender.send(robot).is_err() {
-                break;
-            }
-        }
-    });
-    receiver
-}
-
 fn run(args: &WorldArgs) -> anyhow::Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
@@ -98,6 +74,12 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     };
     let mut world = World::new(&experiment, args.seed)?;
     let robots = world.robot_count();
+    let controller_ids: Vec<&str> = experiment
+        .controllers
+        .iter()
+        .map(|c| c.id.as_str())
+        .collect();
+    let schedule = FaultSchedule::load(&args.config, &args.faults, robots as u32, &controller_ids)?;
     let roster: Vec<(String, String)> = experiment
         .arena
         .robots()
@@ -111,7 +93,16 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
     let mut link = WorldLink::create(&run, link_config)?;
-    let deaths = follow_death_notices(link.death_notices());
+    let launcher = faults::follow_launcher(link.death_notices());
+    let mut faults = FaultDriver::new(
+        &schedule,
+        experiment.framework.ticks_per_second,
+        args.seed,
+        robots,
+        launcher,
+        args.out.clone(),
+        Duration::from_millis(args.join_timeout_ms),
+    );
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
     let mut events = EventsWriter::create(&args.out, &roster)?;
     recorder.record_initial(&world)?;
@@ -119,15 +110,13 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         robots: robots as u32,
     });
 
-    link.wait_for_agents(Duration::from_millis(args.join_timeout_ms))
-        .context("waiting for the robot agents to join")?;
-    let started = Instant::now();
-    let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
+    faults.wait_for_agents(&mut link, &mut world, &mut events, &commands)?;
+    let started = Instant::now();
+    let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
-    let mut dead = vec![false; robots];
     let mut robot_steps: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
@@ -135,16 +124,20 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         && !world.is_finished()
         && (args.ticks == 0 || link.tick() < args.ticks)
     {
-        for robot in deaths.try_iter() {
-            if let Some(flag) = dead.get_mut(robot as usize) {
-                *flag = true;
-                world.set_alive(RobotId(robot), false);
-            }
-        }
+        faults.before_tick(
+            link.tick() + 1,
+            &mut link,
+            &mut world,
+            &mut events,
+            &commands,
+        )?;
         let tick_started = Instant::now();
         let outcome = link.tick_with(|_, frames| world.sense(frames))?;
         for robot in 0..robots {
-            match link.command(robot as u32) {
+            match link
+                .command(robot as u32)
+                .filter(|_| faults.is_alive(robot))
+            {
                 Some(command) => {
                     commands[robot] = *command;
                     has_command[robot] = true;
@@ -178,6 +171,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
         "real_time": pacer.summary(ticks),
+        "alive_final": faults.alive_count(),
     });
     recorder.finish(&world, extra)?;
     events.flush()?;

@@ -1,0 +1,451 @@
+//! Faults in the world process: the schedule, death notices, deadline detection, restarts and thaws, applied
+//! between two ticks so that a scheduled fault always takes effect at its tick whatever the OS timing.
+//!
+//! Between tick k − 1 and tick k ([`FaultDriver::before_tick`]), in this order:
+//! 1. the launcher's death notices: each robot still alive is marked dead from tick k (`down k r notice`);
+//! 2. robots that missed tick k − 1's deadline are marked dead (`down k r deadline`): a frozen or hung agent
+//!    never stalls more than one tick;
+//! 3. robots come back (`up k r`): a robot marked dead by the deadline whose agent answered again, a restarted
+//!    robot whose replacement has joined (at its `rejoin` tick when the launcher gave one: the world holds that
+//!    tick until the replacement is there);
+//! 4. the faults the schedule has due at tick k are recorded and reported (`fault k kill 3`, then `await k`),
+//!    and the world waits for the launcher's `applied k` before it opens the tick; thawed robots then take part
+//!    again.
+//!
+//! Every robot marked dead gets a resume point (its last recorded supervisor snapshot) before the launcher hears
+//! of it, so a replacement agent can continue from it. A dead robot stays in the arena as an inert body with its
+//! LEDs off; its frame says `alive = 0`, and anything its agent sends is ignored until it is back.
+//! This module never signals a process: the launcher does that.
+
+use std::io::BufRead;
+use std::path::PathBuf;
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use swarm_runtime::config::faults::{FaultKind, FaultSchedule};
+use swarm_runtime::launcher::faults::{FaultAction, FaultPlan};
+use swarm_runtime::launcher::resume::ResumePoint;
+use swarm_runtime::launcher::world_control::WorldCommand;
+use swarm_runtime::launcher::world_report::{DownCause, WorldReport};
+use swarm_runtime::messages::ActuatorCommand;
+use swarm_runtime::transport::{CommandStatus, DeathNotices, WorldLink};
+use swarm_world::World;
+use swarm_world::entities::RobotId;
+
+use crate::events::EventsWriter;
+use crate::report;
+
+/// How long the world waits for the launcher to apply the faults of a tick.
+const APPLY_TIMEOUT: Duration = Duration::from_secs(30);
+/// How often the world looks at joins and notices while it waits for agents before the first tick.
+const JOIN_POLL: Duration = Duration::from_millis(20);
+
+/// Why a robot is not taking part.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Down {
+    /// Killed by the schedule.
+    Killed,
+    /// The launcher's death notice.
+    Notice,
+    /// Missed a deadline (its agent may still run).
+    Deadline,
+    /// Frozen by the schedule.
+    Frozen,
+}
+
+/// A robot as the world sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Robot {
+    Alive,
+    Down(Down),
+}
+
+/// The world's fault state: the plan, each robot's state and the launcher's lines.
+pub struct FaultDriver {
+    plan: FaultPlan,
+    robots: Vec<Robot>,
+    /// Tick at which a restarted robot's replacement takes part (from the launcher's `rejoin`).
+    rejoin_at: Vec<Option<u64>>,
+    /// Robots the schedule kills at start-up (tick 0).
+    startup_kills: Vec<u32>,
+    commands: Receiver<WorldCommand>,
+    notices: Vec<u32>,
+    applied: Vec<u64>,
+    /// Scratch: the faults due now and the live-robot mask for random picks.
+    due: Vec<FaultAction>,
+    alive_mask: Vec<bool>,
+    out_dir: PathBuf,
+    join_timeout: Duration,
+}
+
+/// Reads the launcher's lines on standard input: a death notice reaches the transport at once (so the current
+/// tick stops waiting), and every line goes to the main loop, which applies it between ticks.
+pub fn follow_launcher(notices: DeathNotices) -> Receiver<WorldCommand> {
+    let (sender, receiver) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines() {
+            let Ok(line) = line else { break };
+            let Some(command) = WorldCommand::parse(&line) else {
+                tracing::warn!("ignoring the launcher line '{line}'");
+                continue;
+            };
+            if let WorldCommand::Dead(robot) = command
+                && let Err(e) = notices.mark_dead(robot)
+            {
+                tracing::warn!("ignoring death notice '{line}': {e}");
+                continue;
+            }
+            if sender.send(command).is_err() {
+                break;
+            }
+        }
+    });
+    receiver
+}
+
+impl FaultDriver {
+    /// The driver of a run of `robots` robots with `schedule`, seeded with `seed`.
+    pub fn new(
+        schedule: &FaultSchedule,
+        ticks_per_second: u32,
+        seed: u64,
+        robots: usize,
+        commands: Receiver<WorldCommand>,
+        out_dir: PathBuf,
+        join_timeout: Duration,
+    ) -> FaultDriver {
+        let mut plan = FaultPlan::new(schedule, ticks_per_second, seed);
+        let mut due = Vec::new();
+        plan.due(0, &vec![true; robots], &mut due);
+        let startup_kills = due
+            .iter()
+            .filter(|a| a.kind == FaultKind::Kill)
+            .filter_map(|a| a.robot)
+            .collect();
+        due.clear();
+        FaultDriver {
+            plan,
+            robots: vec![Robot::Alive; robots],
+            rejoin_at: vec![None; robots],
+            startup_kills,
+            commands,
+            notices: Vec::new(),
+            applied: Vec::new(),
+            due,
+            alive_mask: vec![true; robots],
+            out_dir,
+            join_timeout,
+        }
+    }
+
+    /// Whether robot `robot` takes part in the coming tick.
+    pub fn is_alive(&self, robot: usize) -> bool {
+        self.robots.get(robot) == Some(&Robot::Alive)
+    }
+
+    /// Robots taking part.
+    pub fn alive_count(&self) -> usize {
+        self.robots.iter().filter(|r| **r == Robot::Alive).count()
+    }
+
+    /// Waits until every robot has an agent, except those killed at start-up, whose death notices must have
+    /// arrived (so a start-up kill takes effect before tick 1 in every run).
+    pub fn wait_for_agents(
+        &mut self,
+        link: &mut WorldLink,
+        world: &mut World,
+        events: &mut EventsWriter,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
+        let deadline = Instant::now() + self.join_timeout;
+        loop {
+            self.drain();
+            for robot in std::mem::take(&mut self.notices) {
+                if self.robots[robot as usize] == Robot::Alive {
+                    if self.startup_kills.contains(&robot) {
+                        self.mark_down(robot, Down::Killed, 0, world, events, commands)?;
+                        events.record_fault(0, robot as usize, "fault:kill")?;
+                    } else {
+                        self.mark_down(robot, Down::Notice, 0, world, events, commands)?;
+                    }
+                }
+            }
+            let missing: Vec<u32> = (0..self.robots.len() as u32)
+                .filter(|&r| self.robots[r as usize] == Robot::Alive && !link.agent_present(r))
+                .collect();
+            if missing.is_empty() {
+                return Ok(());
+            }
+            if Instant::now() > deadline {
+                bail!(
+                    "waiting for the robot agents to join: robots {missing:?} did not join within {:?}",
+                    self.join_timeout
+                );
+            }
+            // Wakes early when an agent joins; notices are polled.
+            let _ = link.wait_for_agents(JOIN_POLL);
+        }
+    }
+
+    /// Applies everything due between the last tick and tick `tick` (see the module documentation).
+    pub fn before_tick(
+        &mut self,
+        tick: u64,
+        link: &mut WorldLink,
+        world: &mut World,
+        events: &mut EventsWriter,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
+        self.drain();
+        for robot in std::mem::take(&mut self.notices) {
+            match self.robots[robot as usize] {
+                Robot::Alive => {
+                    self.mark_down(robot, Down::Notice, tick, world, events, commands)?;
+                }
+                Robot::Down(Down::Deadline | Down::Frozen) => {
+                    self.robots[robot as usize] = Robot::Down(Down::Notice);
+                }
+                Robot::Down(Down::Notice | Down::Killed) => continue,
+            }
+            report(WorldReport::Down {
+                tick,
+                robot,
+                cause: DownCause::Notice,
+            });
+        }
+        if tick > 1 {
+            for robot in 0..self.robots.len() as u32 {
+                let status = link.statuses()[robot as usize];
+                match self.robots[robot as usize] {
+                    Robot::Alive if status == CommandStatus::Missing => {
+                        link.mark_dead(robot)?;
+                        self.mark_down(robot, Down::Deadline, tick, world, events, commands)?;
+                        report(WorldReport::Down {
+                            tick,
+                            robot,
+                            cause: DownCause::Deadline,
+                        });
+                    }
+                    Robot::Down(Down::Deadline)
+                        if link.command(robot).is_some() && link.revive(robot) =>
+                    {
+                        self.mark_up(robot, tick, world, events)?;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        for robot in 0..self.robots.len() as u32 {
+            let r = robot as usize;
+            if !matches!(self.robots[r], Robot::Down(Down::Notice | Down::Killed)) {
+                continue;
+            }
+            match self.rejoin_at[r] {
+                Some(at) if at > tick => {}
+                Some(at) if at == tick => {
+                    self.wait_for_replacement(robot, link)?;
+                    self.rejoin_at[r] = None;
+                    self.mark_up(robot, tick, world, events)?;
+                }
+                _ => {
+                    if link.agent_present(robot) {
+                        self.rejoin_at[r] = None;
+                        self.mark_up(robot, tick, world, events)?;
+                    }
+                }
+            }
+        }
+        self.scheduled(tick, link, world, events, commands)
+    }
+
+    /// The schedule's faults at `tick`: record, report, wait for the launcher to apply them.
+    fn scheduled(
+        &mut self,
+        tick: u64,
+        link: &WorldLink,
+        world: &mut World,
+        events: &mut EventsWriter,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
+        if self.plan.next_due(tick) != Some(tick) {
+            return Ok(());
+        }
+        for (mask, robot) in self.alive_mask.iter_mut().zip(&self.robots) {
+            *mask = *robot == Robot::Alive;
+        }
+        self.due.clear();
+        self.plan.due(tick, &self.alive_mask, &mut self.due);
+        let due = std::mem::take(&mut self.due);
+        let mut reported = false;
+        let mut thawed = Vec::new();
+        for action in &due {
+            let applies = match (action.kind, action.robot) {
+                (FaultKind::KillWorld, _) => true,
+                (FaultKind::Kill, Some(r)) => {
+                    matches!(
+                        self.robots[r as usize],
+                        Robot::Alive | Robot::Down(Down::Frozen | Down::Deadline)
+                    )
+                }
+                (FaultKind::Freeze, Some(r)) => self.robots[r as usize] == Robot::Alive,
+                (FaultKind::Thaw, Some(r)) => self.robots[r as usize] == Robot::Down(Down::Frozen),
+                _ => false,
+            };
+            if !applies {
+                tracing::info!(
+                    tick,
+                    ?action,
+                    "scheduled fault skipped: the robot is not in a state it applies to"
+                );
+                continue;
+            }
+            match (action.kind, action.robot) {
+                (FaultKind::Kill, Some(robot)) => {
+                    let was_alive = self.robots[robot as usize] == Robot::Alive;
+                    if was_alive {
+                        link.mark_dead(robot)?;
+                        self.mark_down(robot, Down::Killed, tick, world, events, commands)?;
+                    }
+                    self.robots[robot as usize] = Robot::Down(Down::Killed);
+                    events.record_fault(tick, robot as usize, "fault:kill")?;
+                }
+                (FaultKind::Freeze, Some(robot)) => {
+                    link.mark_dead(robot)?;
+                    self.mark_down(robot, Down::Frozen, tick, world, events, commands)?;
+                    events.record_fault(tick, robot as usize, "fault:freeze")?;
+                }
+                (FaultKind::Thaw, Some(robot)) => thawed.push(robot),
+                _ => {}
+            }
+            reported = true;
+            report(WorldReport::Fault {
+                tick,
+                kind: action.kind,
+                robot: action.robot,
+            });
+        }
+        self.due = due;
+        if !reported {
+            return Ok(());
+        }
+        events.flush()?;
+        report(WorldReport::Await { tick });
+        self.wait_applied(tick)?;
+        for robot in thawed {
+            if link.revive(robot) {
+                events.record_fault(tick, robot as usize, "fault:thaw")?;
+                self.mark_up(robot, tick, world, events)?;
+            } else {
+                tracing::warn!(robot, tick, "a thawed robot's agent is gone; it stays dead");
+                self.robots[robot as usize] = Robot::Down(Down::Notice);
+            }
+        }
+        Ok(())
+    }
+
+    /// Marks `robot` dead from `tick`: inert body, resume point, `events.csv` row.
+    fn mark_down(
+        &mut self,
+        robot: u32,
+        cause: Down,
+        tick: u64,
+        world: &mut World,
+        events: &mut EventsWriter,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
+        self.robots[robot as usize] = Robot::Down(cause);
+        world.set_alive(RobotId(robot), false);
+        let last = commands
+            .get(robot as usize)
+            .copied()
+            .unwrap_or_else(|| ActuatorCommand::idle(robot, 0));
+        ResumePoint {
+            robot,
+            tick: last.tick,
+            snapshot: last.supervisors,
+        }
+        .write(&self.out_dir)?;
+        // Scheduled faults get their own row from the schedule.
+        match cause {
+            Down::Killed | Down::Frozen => Ok(()),
+            Down::Notice => Ok(events.record_fault(tick, robot as usize, "fault:down")?),
+            Down::Deadline => Ok(events.record_fault(tick, robot as usize, "fault:missed")?),
+        }
+    }
+
+    /// `robot` takes part again from `tick`.
+    fn mark_up(
+        &mut self,
+        robot: u32,
+        tick: u64,
+        world: &mut World,
+        events: &mut EventsWriter,
+    ) -> anyhow::Result<()> {
+        self.robots[robot as usize] = Robot::Alive;
+        world.set_alive(RobotId(robot), true);
+        events.record_fault(tick, robot as usize, "fault:up")?;
+        report(WorldReport::Up { tick, robot });
+        Ok(())
+    }
+
+    /// Holds the tick until a restarted robot's replacement has joined (or the join timeout passes).
+    fn wait_for_replacement(&mut self, robot: u32, link: &mut WorldLink) -> anyhow::Result<()> {
+        let deadline = Instant::now() + self.join_timeout;
+        while !link.agent_present(robot) {
+            if Instant::now() > deadline {
+                bail!(
+                    "robot {robot}'s replacement agent did not join within {:?}",
+                    self.join_timeout
+                );
+            }
+            let _ = link.wait_for_agents(JOIN_POLL);
+        }
+        Ok(())
+    }
+
+    /// Takes the launcher's lines that arrived so far.
+    fn drain(&mut self) {
+        while let Ok(command) = self.commands.try_recv() {
+            self.take(command);
+        }
+    }
+
+    fn take(&mut self, command: WorldCommand) {
+        match command {
+            WorldCommand::Dead(robot) if (robot as usize) < self.robots.len() => {
+                self.notices.push(robot);
+            }
+            WorldCommand::Rejoin { robot, tick } if (robot as usize) < self.robots.len() => {
+                self.rejoin_at[robot as usize] = Some(tick);
+            }
+            WorldCommand::Applied(tick) => self.applied.push(tick),
+            other => tracing::warn!(?other, "ignoring a launcher line about an unknown robot"),
+        }
+    }
+
+    /// Waits for `applied <tick>`, taking every other line on the way.
+    fn wait_applied(&mut self, tick: u64) -> anyhow::Result<()> {
+        let deadline = Instant::now() + APPLY_TIMEOUT;
+        loop {
+            if let Some(i) = self.applied.iter().position(|&t| t == tick) {
+                self.applied.swap_remove(i);
+                return Ok(());
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.commands.recv_timeout(left) {
+                Ok(command) => self.take(command),
+                Err(RecvTimeoutError::Timeout) => {
+                    bail!(
+                        "the launcher did not apply the faults of tick {tick} within {APPLY_TIMEOUT:?}"
+                    )
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(anyhow::anyhow!("the launcher closed the world's input")).context(
+                        format!("waiting for the faults of tick {tick} to be applied"),
+                    );
+                }
+            }
+        }
+    }
+}
