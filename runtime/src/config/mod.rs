@@ -10,6 +10,7 @@
 //! input: every problem becomes a [`Diagnostic`].
 
 pub mod diagnostic;
+pub mod hosts;
 pub mod model;
 mod parse;
 mod registry;

@@ -11,7 +11,8 @@
 //! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory.
 
 pub mod binaries;
-mod children;
+pub(crate) mod children;
+pub mod hosts;
 pub mod process_args;
 pub mod run_dir;
 pub mod world_report;
@@ -60,6 +61,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// How long a tick waits for a missing command (default: the transport's).
     pub tick_deadline: Option<Duration>,
+    /// Hosts to run the robots on instead of locally (see [`hosts`]).
+    pub hosts: hosts::HostsArgs,
 }
 
 /// What a finished run reports.
@@ -113,6 +116,9 @@ pub enum LaunchError {
     /// The world or agent programs are missing.
     #[error(transparent)]
     Binaries(#[from] BinariesError),
+    /// The hosts of the run cannot be resolved.
+    #[error(transparent)]
+    Hosts(#[from] hosts::HostsError),
     /// A file or process operation failed.
     #[error("{what}: {source}")]
     Io {
@@ -194,6 +200,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .ticks
         .or(experiment.framework.max_ticks())
         .unwrap_or(0);
+    let placement =
+        hosts::HostsPlan::resolve(&options.config, &options.hosts)?.map(|plan| plan.place(robots));
     let out_dir = run_dir::create(options.out.as_deref(), &options.config)
         .map_err(io("creating the run directory"))?;
     let binaries = Binaries::locate()?;
@@ -231,6 +239,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let mut world = children::spawn(
         Command::new(&binaries.world)
             .args(world_args.to_args())
+            .args(options.hosts.to_args())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped()),
     )
@@ -241,8 +250,19 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     children.world = Some(world);
 
     wait_ready(&mut children, &reports, robots)?;
-    children.agents.reserve(roster.len());
-    for (robot, entry) in roster.iter().enumerate() {
+    // With hosts, each host daemon starts its own robots' agents; the world waits for them.
+    let local_roster = if placement.is_some() {
+        &[][..]
+    } else {
+        &roster[..]
+    };
+    if let Some(placement) = &placement {
+        for share in placement {
+            tracing::info!(host = share.name, robots = share.robots.len(), "placed");
+        }
+    }
+    children.agents.reserve(local_roster.len());
+    for (robot, entry) in local_roster.iter().enumerate() {
         let agent_args = AgentArgs {
             run: run_args.clone(),
             robot: robot as u32,

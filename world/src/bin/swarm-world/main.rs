@@ -5,9 +5,11 @@
 //! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
 //! Progress goes to standard output as [`WorldReport`] lines for the launcher; `dead <robot>` lines on standard
 //! input are the launcher's death notices. SIGINT/SIGTERM end the run after the current tick with every record
-//! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`.
+//! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`. With hosts
+//! (`--hosts` or `<hosts>`), the robots run on `swarm host` daemons reached over zenoh instead ([`remote`]).
 
 mod events;
+mod remote;
 
 use std::io::{BufRead, Write};
 use std::process::ExitCode;
@@ -19,15 +21,16 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use clap::Parser;
 use swarm_runtime::config::Experiment;
+use swarm_runtime::launcher::hosts::{HostsArgs, HostsPlan};
 use swarm_runtime::launcher::process_args::WorldArgs;
 use swarm_runtime::launcher::world_report::WorldReport;
 use swarm_runtime::messages::ActuatorCommand;
 use swarm_runtime::transport::{DeathNotices, LinkConfig, RunSpec, WorldLink};
 use swarm_world::World;
-use swarm_world::entities::RobotId;
 use swarm_world::recorder::Recorder;
 
 use events::EventsWriter;
+use remote::Link;
 
 /// Minimum interval between two progress reports to the launcher.
 const REPORT_INTERVAL: Duration = Duration::from_millis(50);
@@ -38,11 +41,14 @@ const REPORT_INTERVAL: Duration = Duration::from_millis(50);
 struct Cli {
     #[command(flatten)]
     args: WorldArgs,
+    #[command(flatten)]
+    hosts: HostsArgs,
 }
 
 fn main() -> ExitCode {
     swarm_runtime::logging::init("info");
-    match run(&Cli::parse().args) {
+    let cli = Cli::parse();
+    match run(&cli.args, &cli.hosts) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("swarm-world: error: {e:#}");
@@ -83,7 +89,7 @@ fn follow_death_notices(notices: DeathNotices) -> Receiver<u32> {
     receiver
 }
 
-fn run(args: &WorldArgs) -> anyhow::Result<()> {
+fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
@@ -108,8 +114,17 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     if let Some(ms) = args.tick_deadline_ms {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
-    let mut link = WorldLink::create(&run, link_config)?;
-    let deaths = follow_death_notices(link.death_notices());
+    let mut link = match HostsPlan::resolve(&args.config, hosts)? {
+        None => {
+            let link = WorldLink::create(&run, link_config)?;
+            let deaths = follow_death_notices(link.death_notices());
+            Link::Local { link, deaths }
+        }
+        Some(plan) => {
+            let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
+            Link::remote(plan, args, controllers, link_config.tick_deadline)?
+        }
+    };
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
     let mut events = EventsWriter::create(&args.out, &roster)?;
     recorder.record_initial(&world)?;
@@ -117,14 +132,12 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         robots: robots as u32,
     });
 
-    link.wait_for_agents(Duration::from_millis(args.join_timeout_ms))
-        .context("waiting for the robot agents to join")?;
+    link.wait(Duration::from_millis(args.join_timeout_ms))?;
     let started = Instant::now();
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
     let mut has_command = vec![false; robots];
-    let mut dead = vec![false; robots];
     let mut robot_steps: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
@@ -132,12 +145,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         && !world.is_finished()
         && (args.ticks == 0 || link.tick() < args.ticks)
     {
-        for robot in deaths.try_iter() {
-            if let Some(flag) = dead.get_mut(robot as usize) {
-                *flag = true;
-                world.set_alive(RobotId(robot), false);
-            }
-        }
+        link.apply_life_changes(&mut world);
         let tick_started = Instant::now();
         let outcome = link.tick_with(|_, frames| world.sense(frames))?;
         for robot in 0..robots {
@@ -167,13 +175,16 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     }
     let ticking = started.elapsed().as_secs_f64();
     let ticks = link.tick();
-    let extra = serde_json::json!({
+    let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
         "ticking_seconds": ticking,
         "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
     });
+    if let (Some(hosts), Some(object)) = (link.summary(), extra.as_object_mut()) {
+        object.insert("hosts".into(), hosts);
+    }
     recorder.finish(&world, extra)?;
     events.flush()?;
     report(WorldReport::Finished { ticks });
