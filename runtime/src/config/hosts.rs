@@ -294,7 +294,7 @@ mod tests {
             "{text}"
         );
         assert!(text.contains(":5:7: invalid host name 'a/b'"), "{text}");
-        assert!(text.contains(":6:19: 'weight' in <host> must be"), "{text}");
+        assert!(text.contains(":6:16: 'weight' in <host> must be"), "{text}");
         assert!(
             text.contains(":7:18: host 'd' appears twice in <hosts> (first at 7:1)"),
             "{text}"

@@ -9,7 +9,7 @@
 //! This module must never panic on a payload: whatever arrives from the network is either decoded or rejected with
 //! a [`WireError`] that says what was wrong.
 
-use bincode::config::{Config, Configuration};
+use bincode::config::Configuration;
 use bincode::{Decode, Encode};
 
 use crate::messages::{ActuatorCommand, MESSAGE_VERSION};

@@ -80,8 +80,10 @@ impl ZenohOptions {
         set("scouting/multicast/enabled", "false".into())?;
         set("scouting/gossip/enabled", "false".into())?;
         set("transport/link/tx/lease", lease_ms.to_string())?;
-        set("connect/retry/period_init_ms", "250".into())?;
-        set("connect/retry/period_max_ms", "1000".into())?;
+        set(
+            "connect/retry",
+            r#"{"period_init_ms": 250, "period_max_ms": 1000, "period_increase_factor": 2}"#.into(),
+        )?;
         if let Some(user) = &self.user {
             set("transport/auth/usrpwd/user", json(user))?;
         }

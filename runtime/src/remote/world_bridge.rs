@@ -28,6 +28,9 @@ use super::{RemoteError, keys};
 use crate::messages::{ActuatorCommand, SensorFrame};
 use crate::transport::{CommandStatus, TickOutcome};
 
+/// Before the first tick, how often unanswered assignments are sent again.
+const RETRY_PERIOD: Duration = Duration::from_millis(100);
+
 /// One host of the placement: its name and the run-wide ids of its robots.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct HostShare {
@@ -92,6 +95,23 @@ enum Incoming {
     HostDown(String),
     Replies(String, Vec<u8>),
     Assigned(usize, Result<Vec<u8>, String>),
+    /// The assignment query of (host, epoch) finished (after its answer, if any).
+    AssignEnded(usize, u32),
+}
+
+/// Says when an assignment query is finished: zenoh drops the reply callback, and this with it.
+struct AssignmentGuard {
+    sender: Sender<Incoming>,
+    host: usize,
+    epoch: u32,
+}
+
+impl Drop for AssignmentGuard {
+    fn drop(&mut self) {
+        let _ = self
+            .sender
+            .send(Incoming::AssignEnded(self.host, self.epoch));
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -192,7 +212,8 @@ impl RemoteHosts {
         for share in &options.hosts {
             let publisher = session
                 .declare_publisher(keys::frames(run, &share.name))
-                .congestion_control(CongestionControl::Block)
+                // A stalled link must never block the world: a dropped batch is a missed tick for that host.
+                .congestion_control(CongestionControl::Drop)
                 .express(true)
                 .wait()
                 .map_err(zenoh_error("declaring a frames publisher"))?;
@@ -259,10 +280,23 @@ impl RemoteHosts {
                         .map_or("<endpoint>", String::as_str)
                 )));
             }
-            match self.incoming.recv_timeout(deadline - now) {
+            match self
+                .incoming
+                .recv_timeout((deadline - now).min(RETRY_PERIOD))
+            {
                 Ok(event) => self.handle(event, true)?,
-                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Timeout) => self.retry_assignments()?,
                 Err(RecvTimeoutError::Disconnected) => break,
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends their share again to hosts that are up but whose last assignment went unanswered.
+    fn retry_assignments(&mut self) -> Result<(), RemoteError> {
+        for index in 0..self.hosts.len() {
+            if self.hosts[index].up && self.hosts[index].state == State::Absent {
+                self.assign(index)?;
             }
         }
         Ok(())
@@ -285,6 +319,7 @@ impl RemoteHosts {
         while let Ok(event) = self.incoming.try_recv() {
             self.handle(event, false)?;
         }
+        self.retry_assignments()?;
         for (i, frame) in self.frames.iter_mut().enumerate() {
             *frame = SensorFrame::empty(i as u32);
             frame.tick = tick;
@@ -393,6 +428,16 @@ impl RemoteHosts {
                 }
             }
             Incoming::Assigned(index, answer) => self.assigned(index, answer, before_run)?,
+            Incoming::AssignEnded(index, epoch) => {
+                // No answer (e.g. the host's queryable was not known yet after a reconnection): try again later.
+                if let Some(host) = self.hosts.get_mut(index)
+                    && host.epoch == epoch
+                    && host.state == State::Assigning
+                {
+                    tracing::debug!(host = host.share.name, epoch, "assignment unanswered");
+                    host.state = State::Absent;
+                }
+            }
             Incoming::Replies(name, bytes) => self.replies(&name, &bytes),
         }
         Ok(())
@@ -434,6 +479,11 @@ impl RemoteHosts {
         };
         let payload = codec::encode_message(&assignment)?;
         let sender = self.sender.clone();
+        let ended = AssignmentGuard {
+            sender: self.sender.clone(),
+            host: index,
+            epoch: host.epoch,
+        };
         tracing::info!(
             host = host.share.name,
             epoch = host.epoch,
@@ -445,6 +495,7 @@ impl RemoteHosts {
             .payload(payload)
             .timeout(self.options.join_timeout + Duration::from_secs(5))
             .callback(move |reply| {
+                let _ = &ended;
                 let answer = match reply.result() {
                     Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
                     Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
@@ -602,5 +653,249 @@ impl RemoteHosts {
     /// Payloads dropped so far.
     pub fn dropped(&self) -> Dropped {
         self.dropped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The world's side against fake hosts: real zenoh sessions on loopback, hosts played by the test.
+
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use super::*;
+
+    /// How a fake host answers frames.
+    #[derive(Clone, Copy)]
+    enum Behaviour {
+        /// Answers for its own robots.
+        Honest,
+        /// Claims another host's robot in its batch.
+        Impostor(u32),
+        /// Sends bytes that are not a batch.
+        Garbage,
+    }
+
+    /// A host played by the test: answers its assignment, then every frames message, until dropped.
+    struct FakeHost {
+        session: Option<Session>,
+        stop: Arc<AtomicBool>,
+        threads: Vec<std::thread::JoinHandle<()>>,
+    }
+
+    impl FakeHost {
+        fn start(endpoint: &str, name: &str, behaviour: Behaviour) -> FakeHost {
+            let session = ZenohOptions::default()
+                .open_host(endpoint)
+                .expect("the fake host connects");
+            let stop = Arc::new(AtomicBool::new(false));
+            let queryable = session
+                .declare_queryable(keys::assign(name))
+                .wait()
+                .expect("queryable");
+            let (share_tx, share_rx) = mpsc::channel();
+            let flag = Arc::clone(&stop);
+            let declaring = session.clone();
+            let token_key = keys::host_token(name);
+            let name = name.to_owned();
+            let assign = std::thread::spawn(move || {
+                while !flag.load(Ordering::Relaxed) {
+                    let Ok(Some(query)) = queryable.recv_timeout(Duration::from_millis(20)) else {
+                        continue;
+                    };
+                    let bytes = query
+                        .payload()
+                        .map(|p| p.to_bytes().into_owned())
+                        .unwrap_or_default();
+                    let assignment: Assignment =
+                        codec::decode_message(&bytes, codec::DEFAULT_MAX_PAYLOAD)
+                            .expect("an assignment");
+                    // Like a real host: ready to receive frames before saying so.
+                    let frames = declaring
+                        .declare_subscriber(keys::frames(assignment.run, &name))
+                        .wait()
+                        .expect("subscriber");
+                    let publisher = declaring
+                        .declare_publisher(keys::replies(assignment.run, &name))
+                        .wait()
+                        .expect("publisher");
+                    let robots: Vec<u32> = assignment.robots.iter().map(|(r, _)| *r).collect();
+                    let _ = share_tx.send((robots, frames, publisher));
+                    let reply = codec::encode_message(&AssignmentReply::Ready {
+                        epoch: assignment.epoch,
+                    })
+                    .expect("encodes");
+                    query
+                        .reply(query.key_expr().clone(), reply)
+                        .wait()
+                        .expect("reply");
+                }
+            });
+            let token = session
+                .liveliness()
+                .declare_token(token_key)
+                .wait()
+                .expect("token");
+            let flag = Arc::clone(&stop);
+            let answer = std::thread::spawn(move || {
+                let _token = token;
+                // The world assigns the share once it sees the token, i.e. once the test waits for the hosts.
+                let Ok((robots, frames, publisher)) = share_rx.recv() else {
+                    return;
+                };
+                let mut out = vec![SensorFrame::empty(0); robots.len()];
+                let mut buf = Vec::new();
+                while !flag.load(Ordering::Relaxed) {
+                    let Ok(Some(sample)) = frames.recv_timeout(Duration::from_millis(20)) else {
+                        continue;
+                    };
+                    let bytes = sample.payload().to_bytes();
+                    let header =
+                        codec::decode_batch(&bytes, Kind::Frames, &robots, &mut out, 1 << 20)
+                            .expect("frames decode");
+                    let reply_header = Header::new(
+                        Kind::Replies,
+                        header.run,
+                        header.host,
+                        header.epoch,
+                        header.tick,
+                    );
+                    let mut claimed = robots.clone();
+                    if let Behaviour::Impostor(other) = behaviour {
+                        claimed[0] = other;
+                    }
+                    let replies: Vec<Reply> = claimed
+                        .iter()
+                        .map(|&r| {
+                            let mut command = ActuatorCommand::idle(r, header.tick);
+                            command.wheels = [1.0, 2.0];
+                            Reply::Answered(command)
+                        })
+                        .collect();
+                    codec::encode_batch(&mut buf, &reply_header, &claimed, &replies)
+                        .expect("encodes");
+                    if let Behaviour::Garbage = behaviour {
+                        buf = b"not a batch".to_vec();
+                    }
+                    publisher.put(buf.clone()).wait().expect("put");
+                }
+            });
+            FakeHost {
+                session: Some(session),
+                stop,
+                threads: vec![assign, answer],
+            }
+        }
+    }
+
+    impl Drop for FakeHost {
+        fn drop(&mut self) {
+            self.stop.store(true, Ordering::Relaxed);
+            for thread in self.threads.drain(..) {
+                let _ = thread.join();
+            }
+            if let Some(session) = self.session.take() {
+                let _ = session.close().wait();
+            }
+        }
+    }
+
+    fn world(endpoint: &str, shares: &[(&str, &[u32])]) -> RemoteHosts {
+        let robots: u32 = shares.iter().map(|(_, r)| r.len() as u32).sum();
+        let options = RemoteOptions {
+            listen: vec![endpoint.to_owned()],
+            zenoh: ZenohOptions::default(),
+            hosts: shares
+                .iter()
+                .map(|(name, robots)| HostShare {
+                    name: (*name).to_owned(),
+                    robots: robots.to_vec(),
+                })
+                .collect(),
+            controllers: vec!["c".into(); robots as usize],
+            config: PathBuf::from("/experiment.argos"),
+            seed: 1,
+            robots_override: None,
+            tick_deadline: Duration::from_millis(300),
+            join_timeout: Duration::from_secs(30),
+            max_payload: codec::DEFAULT_MAX_PAYLOAD,
+        };
+        RemoteHosts::start(options, robots, 0x5eed).expect("the world listens")
+    }
+
+    fn endpoint() -> String {
+        let port = std::net::TcpListener::bind(("127.0.0.1", 0))
+            .and_then(|l| l.local_addr())
+            .map(|a| a.port())
+            .expect("a free port");
+        format!("tcp/127.0.0.1:{port}")
+    }
+
+    #[test]
+    fn replies_naming_another_hosts_robot_are_rejected_whole() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("honest", &[0, 1]), ("impostor", &[2])]);
+        let _honest = FakeHost::start(&endpoint, "honest", Behaviour::Honest);
+        let _impostor = FakeHost::start(&endpoint, "impostor", Behaviour::Impostor(0));
+        world
+            .wait_for_hosts(Duration::from_secs(30))
+            .expect("both hosts join");
+        let outcome = world.tick_with(|_, _| {}).expect("a tick");
+        assert_eq!((outcome.answered, outcome.missing, outcome.dead), (2, 1, 0));
+        assert_eq!(world.command(0).map(|c| c.wheels), Some([1.0, 2.0]));
+        assert_eq!(
+            world.command(2),
+            None,
+            "the impostor's batch must not command robot 2"
+        );
+        assert!(world.dropped().rejected >= 1);
+    }
+
+    #[test]
+    fn a_malformed_batch_is_dropped_and_counted_and_the_tick_goes_on() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("garbled", &[0])]);
+        let _host = FakeHost::start(&endpoint, "garbled", Behaviour::Garbage);
+        world
+            .wait_for_hosts(Duration::from_secs(30))
+            .expect("the host joins");
+        for tick in 1..=2 {
+            let outcome = world.tick_with(|_, _| {}).expect("a tick");
+            assert_eq!((outcome.tick, outcome.missing), (tick, 1));
+        }
+        assert!(world.dropped().rejected >= 2, "{:?}", world.dropped());
+    }
+
+    #[test]
+    fn a_host_whose_session_ends_is_lost_and_its_robots_die_at_a_recorded_tick() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("stays", &[0]), ("goes", &[1, 2])]);
+        let _stays = FakeHost::start(&endpoint, "stays", Behaviour::Honest);
+        let goes = FakeHost::start(&endpoint, "goes", Behaviour::Honest);
+        world
+            .wait_for_hosts(Duration::from_secs(30))
+            .expect("both hosts join");
+        let first = world.tick_with(|_, _| {}).expect("a tick");
+        assert_eq!(first.answered, 3);
+        drop(goes);
+        // The loss is decided within a tick or two (the session's end is seen in milliseconds); no tick blocks.
+        let mut lost_at = None;
+        for _ in 0..50 {
+            let outcome = world.tick_with(|_, _| {}).expect("a tick");
+            if outcome.dead == 2 {
+                lost_at = Some(outcome.tick);
+                break;
+            }
+        }
+        let lost_at = lost_at.expect("the host was declared lost");
+        let changes: Vec<(u32, bool)> = world.take_changes().collect();
+        assert_eq!(changes, [(1, false), (2, false)]);
+        let events: Vec<HostEvent> = world
+            .host_events()
+            .find(|(share, _)| share.name == "goes")
+            .map(|(_, events)| events.to_vec())
+            .expect("the host is listed");
+        assert_eq!(events, [HostEvent::Lost { tick: lost_at }]);
+        assert_eq!(world.statuses()[0], CommandStatus::Answered);
     }
 }
