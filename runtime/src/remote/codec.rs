@@ -70,6 +70,9 @@ impl Header {
 }
 
 /// A host's answer for one robot in one tick.
+// Replies live in preallocated per-host slots and are decoded in place each tick; boxing the command would
+// allocate per robot per tick.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Encode, Decode)]
 pub enum Reply {
     /// The robot's agent answered with this command (its `robot` field is the run-wide robot id).

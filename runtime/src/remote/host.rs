@@ -135,13 +135,13 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
                     }
                 }
             }
-            Some(Event::WorldGone { run }) => {
-                if share.as_ref().is_some_and(|s| s.assignment.run == run) {
-                    tracing::info!(run = format!("{run:016x}"), "the world ended the run");
-                    share = None;
-                }
+            Some(Event::WorldGone { run })
+                if share.as_ref().is_some_and(|s| s.assignment.run == run) =>
+            {
+                tracing::info!(run = format!("{run:016x}"), "the world ended the run");
+                share = None;
             }
-            None => {}
+            Some(Event::WorldGone { .. }) | None => {}
         }
         if let Some(current) = share.as_mut() {
             current.reap();

@@ -1,6 +1,7 @@
 //! Opening the zenoh sessions of a multi-host run: the world listens, each host daemon connects to it.
 //!
-//! Multicast scouting is off and every endpoint is explicit, so nothing is discovered by accident. The world runs in
+//! Multicast scouting is off and every endpoint is explicit, so nothing is discovered by accident (hosts are
+//! clients, so the world's peer gossip never reaches them). The world runs in
 //! peer mode and listens (loopback by default); hosts run in client mode and connect to one of its endpoints,
 //! retrying every second while it is unreachable (so a host whose network came back rejoins by itself). The link
 //! lease decides how fast a frozen or cut-off host is noticed (default 1 s; a killed one is noticed in
@@ -78,7 +79,6 @@ impl ZenohOptions {
         };
         set("mode", json(mode))?;
         set("scouting/multicast/enabled", "false".into())?;
-        set("scouting/gossip/enabled", "false".into())?;
         set("transport/link/tx/lease", lease_ms.to_string())?;
         set(
             "connect/retry",

@@ -19,6 +19,8 @@ use swarm_world::World;
 use swarm_world::entities::RobotId;
 
 /// Where the world's robots run.
+// One value per world process, created once: the size difference between the variants costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum Link {
     /// Agents on this machine, with the launcher's death notices.
     Local {
@@ -28,7 +30,7 @@ pub enum Link {
         deaths: Receiver<u32>,
     },
     /// Agents on `swarm host` daemons.
-    Remote(Box<RemoteHosts>),
+    Remote(RemoteHosts),
 }
 
 impl Link {
@@ -59,7 +61,7 @@ impl Link {
             .map_or(0, |d| d.as_nanos() as u64)
             ^ (u64::from(std::process::id()) << 40);
         let hosts = RemoteHosts::start(options, robots, run).context("listening for hosts")?;
-        Ok(Link::Remote(Box::new(hosts)))
+        Ok(Link::Remote(hosts))
     }
 
     /// Waits until every robot has an agent (locally) or every host runs its share.
