@@ -84,7 +84,8 @@ fn run(ticks: u64, hosts: u32) -> f64 {
         .args(["--ticks", &ticks.to_string(), "--out"])
         .arg(&out)
         .env("RUST_LOG", "warn")
-        .current_dir(workspace());
+        .current_dir(workspace())
+        .stdout(Stdio::null());
     if hosts > 0 {
         command.args(["--hosts", &names.join(","), "--listen", &endpoint]);
     }
