@@ -256,6 +256,55 @@ mod tests {
         assert_eq!(sizes(&place(1, &hosts("a,b"))), [("a".into(), 1)]);
     }
 
+    fn experiment(dir: &Path, hosts: &str) -> PathBuf {
+        let path = dir.join("x.argos");
+        let text = format!(
+            "<argos-configuration><framework><experiment length=\"1\" ticks_per_second=\"10\" />{hosts}\
+             </framework></argos-configuration>"
+        );
+        std::fs::write(&path, text).expect("write");
+        path
+    }
+
+    #[test]
+    fn a_run_without_hosts_is_local_and_the_flag_overrides_the_experiments_list() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let local = experiment(dir.path(), "");
+        assert!(
+            HostsPlan::resolve(&local, &HostsArgs::default())
+                .expect("valid")
+                .is_none()
+        );
+
+        std::fs::write(dir.path().join("pw"), "secret\n").expect("write");
+        let config = experiment(
+            dir.path(),
+            r#"<hosts listen="tcp/10.0.0.1:7447" lease_ms="700" user="swarm" password_file="pw"><host name="a" /></hosts>"#,
+        );
+        let plan = HostsPlan::resolve(&config, &HostsArgs::default())
+            .expect("valid")
+            .expect("hosts");
+        assert_eq!(plan.hosts, hosts("a"));
+        assert_eq!(plan.listen, ["tcp/10.0.0.1:7447"]);
+        assert_eq!(plan.zenoh.lease, Duration::from_millis(700));
+        assert_eq!(plan.zenoh.password.as_deref(), Some("secret"));
+
+        let args = HostsArgs {
+            hosts: Some("b:2,c".into()),
+            listen: vec!["tcp/127.0.0.1:9000".into()],
+        };
+        let plan = HostsPlan::resolve(&config, &args)
+            .expect("valid")
+            .expect("hosts");
+        assert_eq!(plan.hosts, hosts("b:2,c"));
+        assert_eq!(plan.listen, ["tcp/127.0.0.1:9000"]);
+        assert_eq!(
+            plan.zenoh.lease,
+            Duration::from_millis(700),
+            "the other attributes still apply"
+        );
+    }
+
     #[test]
     fn malformed_hosts_flags_say_what_is_wrong() {
         for (flag, expected) in [
