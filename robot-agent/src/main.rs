@@ -34,6 +34,10 @@ struct Args {
     /// Index of this robot in the run (0..N).
     #[arg(long)]
     robot: u32,
+    /// Slot of the robot in the local transport when it differs from --robot: a `swarm host` numbers its share
+    /// 0..k locally, while --robot stays the run-wide id that seeds the random stream and picks the controller.
+    #[arg(long)]
+    slot: Option<u32>,
     /// Run seed; the player's random stream is derived from it and the robot index. Default: the
     /// configuration's `random_seed`, or 0 without --config.
     #[arg(long)]
@@ -173,10 +177,12 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
     };
     let mut resumer = Resumer::new(point);
     let run = RunSpec::new(&args.run, root)?;
-    let mut link = join(&run, args.robot)?;
+    let slot = args.slot.unwrap_or(args.robot);
+    let mut link = join(&run, slot)?;
     info!(
         run = args.run.as_str(),
         robot = args.robot,
+        slot,
         "joined the run"
     );
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.

@@ -11,6 +11,7 @@ pub mod launcher;
 pub mod logging;
 pub mod messages;
 pub mod player;
+pub mod remote;
 pub mod transport;
 
 /// The ptSCT toolchain's formats (compiled supervisor sets, models, synthesis), re-exported so that agents reach

@@ -8,7 +8,11 @@
 //! Capacities are compile-time constants because shared-memory layouts must be identical in every process; they
 //! are sized for the e-puck model and the thesis' tasks. Any change to a layout must bump [`MESSAGE_VERSION`],
 //! which is part of every service name, so processes built from different versions never connect.
+//!
+//! Across hosts the same types travel bincode-encoded (`Encode`/`Decode`, field by field, little-endian), never
+//! as raw memory, so hosts of different architectures interoperate (see `remote::codec`).
 
+use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
@@ -36,7 +40,7 @@ pub const MAX_FIRED_STAMPS: usize = 32;
 pub const MAX_EVENTS_PER_TICK: usize = 16;
 
 /// An RGB colour, as LEDs show it and cameras see it. All zero means off.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct Rgb {
     /// Red, 0-255.
@@ -58,7 +62,7 @@ impl Rgb {
 }
 
 /// One LED blob seen by the omnidirectional camera.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct CameraBlob {
     /// Colour of the LED.
@@ -70,7 +74,7 @@ pub struct CameraBlob {
 }
 
 /// One range-and-bearing message received this tick.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct RabMessage {
     /// Index of the sending robot in the run.
@@ -86,7 +90,7 @@ pub struct RabMessage {
 }
 
 /// Everything one robot senses in one tick. Written by the world, read by the robot's agent.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct SensorFrame {
     /// Tick this frame belongs to (1 for the first tick).
@@ -155,7 +159,7 @@ impl SensorFrame {
 }
 
 /// What the virtual gripper should do this tick.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub enum GripperAction {
     /// Keep the current state.
@@ -168,7 +172,7 @@ pub enum GripperAction {
 }
 
 /// The tick at which a controllable self-loop last fired in its supervisor's current state (ptsct.md section 3).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct FiredStamp {
     /// Index of the supervisor in the robot's supervisor set.
@@ -180,7 +184,7 @@ pub struct FiredStamp {
 }
 
 /// The state of a robot's supervisors after a player step: enough to record and to resume them exactly.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct SupervisorSnapshot {
     /// Number of supervisors in use.
@@ -208,7 +212,7 @@ impl Default for SupervisorSnapshot {
 }
 
 /// Everything one robot commands in one tick, plus what it did. Written by the agent, read by the world.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
 pub struct ActuatorCommand {
     /// Tick this command answers (equal to the frame's tick).

@@ -183,3 +183,256 @@ pub fn spawn_swarm(args: &[&str]) -> std::process::Child {
         .spawn()
         .expect("swarm starts")
 }
+/// Removes the shared-memory files and iceoryx2 root directories of every run whose name starts with `run_prefix`
+/// (for processes a test killed with SIGKILL, which cannot clean up themselves).
+pub fn remove_run_leftovers(run_prefix: &str) {
+    for path in shm_leftovers(run_prefix) {
+        let _ = std::fs::remove_file(path);
+    }
+    let root_prefix = format!("iceoryx2-{run_prefix}");
+    if let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) {
+        for entry in entries.flatten() {
+            if entry
+                .file_name()
+                .to_string_lossy()
+                .starts_with(&root_prefix)
+            {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+    }
+}
+
+/// A free TCP port on `ip` (bound once and released, for a zenoh endpoint).
+pub fn free_port(ip: &str) -> u16 {
+    std::net::TcpListener::bind((ip, 0))
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free port")
+}
+
+/// A `swarm host` daemon started by a test (optionally inside a network namespace). Its log lines are collected
+/// so the test can wait for events; dropping it kills it and removes whatever its runs left.
+pub struct HostDaemon {
+    child: std::process::Child,
+    lines: std::sync::mpsc::Receiver<String>,
+    seen: Vec<String>,
+    /// The host name.
+    pub name: String,
+    _logs: tempfile::TempDir,
+}
+
+impl HostDaemon {
+    /// Starts `swarm host --connect <connect> --name <name>`, inside `netns` when given.
+    pub fn start(name: &str, connect: &str, netns: Option<&str>) -> HostDaemon {
+        let dir = bin_dir();
+        let logs = tempfile::tempdir().expect("a temporary directory");
+        let swarm = dir.join("swarm");
+        let mut command = match netns {
+            Some(ns) => {
+                let mut c = Command::new("ip");
+                c.args(["netns", "exec", ns]).arg(&swarm);
+                c
+            }
+            None => Command::new(&swarm),
+        };
+        command
+            .args(["host", "--connect", connect, "--name", name, "--logs"])
+            .arg(logs.path())
+            .env("SWARM_BIN_DIR", dir)
+            .env("RUST_LOG", "info,zenoh=warn")
+            .current_dir(workspace_root())
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        let mut child = command.spawn().expect("swarm host starts");
+        let lines = follow_lines(child.stderr.take());
+        HostDaemon {
+            child,
+            lines,
+            seen: Vec::new(),
+            name: name.to_owned(),
+            _logs: logs,
+        }
+    }
+
+    /// The daemon's process id (`ip netns exec` execs it, so it is the daemon's own).
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Waits until a log line containing `needle` appears after the lines already consumed; false on timeout or
+    /// when the daemon's output ends.
+    pub fn wait_for(&mut self, needle: &str, timeout: std::time::Duration) -> bool {
+        wait_for_line(&self.lines, &mut self.seen, needle, timeout)
+    }
+
+    /// Every log line read so far.
+    pub fn log(&self) -> String {
+        self.seen.join("\n")
+    }
+
+    /// Asks the daemon to stop (SIGTERM) and waits for it; true when it exited successfully.
+    pub fn stop(&mut self) -> bool {
+        let _ = nix::sys::signal::kill(
+            nix::unistd::Pid::from_raw(self.child.id() as i32),
+            nix::sys::signal::Signal::SIGTERM,
+        );
+        self.child.wait().map(|s| s.success()).unwrap_or(false)
+    }
+
+    /// Kills the daemon with SIGKILL (its agents die with it) and removes what its runs left.
+    pub fn kill(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        remove_run_leftovers(&format!("sw{:x}-", self.child.id()));
+    }
+}
+
+impl Drop for HostDaemon {
+    fn drop(&mut self) {
+        self.kill();
+    }
+}
+
+/// Collects the lines of a child's output on a thread.
+pub fn follow_lines(
+    output: Option<impl std::io::Read + Send + 'static>,
+) -> std::sync::mpsc::Receiver<String> {
+    use std::io::BufRead;
+    let (sender, receiver) = std::sync::mpsc::channel();
+    if let Some(output) = output {
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(output).lines() {
+                let Ok(line) = line else { break };
+                if sender.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+    }
+    receiver
+}
+
+/// Waits for a line containing `needle` on `lines`, keeping every line read in `seen`; false on timeout or end.
+pub fn wait_for_line(
+    lines: &std::sync::mpsc::Receiver<String>,
+    seen: &mut Vec<String>,
+    needle: &str,
+    timeout: std::time::Duration,
+) -> bool {
+    let deadline = std::time::Instant::now() + timeout;
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        match lines.recv_timeout(left) {
+            Ok(line) => {
+                let found = line.contains(needle);
+                seen.push(line);
+                if found {
+                    return true;
+                }
+            }
+            Err(_) => return false,
+        }
+    }
+}
+
+/// A Linux network namespace joined to the test's namespace by a veth pair: the world listens on `outer_ip`, a
+/// host inside reaches it from `inner_ip`. Needs root and iproute2; dropping it deletes both.
+pub struct Netns {
+    /// Namespace name (for `ip netns exec`).
+    pub name: String,
+    /// The veth end outside the namespace.
+    pub outer: String,
+    /// Address of the outer end.
+    pub outer_ip: String,
+    /// Address of the inner end.
+    pub inner_ip: String,
+}
+
+/// Whether this process runs with effective user id 0 (the second field of `Uid:` in /proc/self/status).
+fn is_root() -> bool {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|status| {
+            status
+                .lines()
+                .find_map(|l| l.strip_prefix("Uid:"))
+                .and_then(|ids| ids.split_whitespace().nth(1).map(|e| e == "0"))
+        })
+        .unwrap_or(false)
+}
+
+fn ip(args: &[&str]) -> Result<(), String> {
+    let output = Command::new("ip")
+        .args(args)
+        .output()
+        .map_err(|e| format!("ip {}: {e}", args.join(" ")))?;
+    if output.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "ip {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&output.stderr).trim()
+        ))
+    }
+}
+
+impl Netns {
+    /// Creates namespace number `index` (0-99) of this test process, or says why it cannot.
+    pub fn create(index: u32) -> Result<Netns, String> {
+        if !is_root() {
+            return Err("network namespaces need root".into());
+        }
+        let tag = (std::process::id() % 10_000) * 100 + index;
+        let subnet = (std::process::id() % 200) + 20;
+        let ns = Netns {
+            name: format!("swarm-test-{tag}"),
+            outer: format!("swo{tag}"),
+            outer_ip: format!("10.{subnet}.{index}.1"),
+            inner_ip: format!("10.{subnet}.{index}.2"),
+        };
+        let inner = format!("swi{tag}");
+        ip(&["netns", "add", &ns.name])?;
+        let setup = || -> Result<(), String> {
+            ip(&[
+                "link", "add", &ns.outer, "type", "veth", "peer", "name", &inner,
+            ])?;
+            ip(&["link", "set", &inner, "netns", &ns.name])?;
+            ip(&[
+                "addr",
+                "add",
+                &format!("{}/24", ns.outer_ip),
+                "dev",
+                &ns.outer,
+            ])?;
+            ip(&["link", "set", &ns.outer, "up"])?;
+            ip(&[
+                "-n",
+                &ns.name,
+                "addr",
+                "add",
+                &format!("{}/24", ns.inner_ip),
+                "dev",
+                &inner,
+            ])?;
+            ip(&["-n", &ns.name, "link", "set", &inner, "up"])?;
+            ip(&["-n", &ns.name, "link", "set", "lo", "up"])
+        };
+        // On failure `ns` is dropped here, which deletes whatever was created.
+        setup().map(|()| ns)
+    }
+
+    /// Cuts (false) or restores (true) the link between the namespace and the test's namespace.
+    pub fn set_link(&self, up: bool) -> Result<(), String> {
+        ip(&["link", "set", &self.outer, if up { "up" } else { "down" }])
+    }
+}
+
+impl Drop for Netns {
+    fn drop(&mut self) {
+        let _ = ip(&["link", "del", &self.outer]);
+        let _ = ip(&["netns", "del", &self.name]);
+    }
+}

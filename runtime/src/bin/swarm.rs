@@ -5,6 +5,9 @@
 //! its tick and flushes its records, and every process and shared-memory file of the run is removed.
 //! `swarm run --fault "kill robots=3 tick=50"` adds faults to the configuration's `<faults>`, and
 //! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot>` drives a live run (docs/faults.md).
+//!
+//! `swarm host --connect <endpoint>` runs one machine's share of multi-host runs (docs/hosts.md); `swarm run
+//! --hosts a,b` places a run's robots on such hosts.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -13,10 +16,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::Context;
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use swarm_runtime::bench::BenchOptions;
 use swarm_runtime::launcher::control::{self, CtlCommand};
+use swarm_runtime::launcher::hosts::HostsArgs;
 use swarm_runtime::launcher::{self, RunOptions};
+use swarm_runtime::remote::codec::DEFAULT_MAX_PAYLOAD;
+use swarm_runtime::remote::host::{self, HostOptions};
+use swarm_runtime::remote::session::{DEFAULT_LEASE, ZenohOptions};
 
 /// Runs swarms of robot processes executing ptSCT supervisors.
 #[derive(Debug, Parser)]
@@ -58,6 +65,9 @@ enum Commands {
         /// "kill robots=3 tick=50", "chaos every=2 count=1", "restart policy=on-failure max_restarts=2".
         #[arg(long = "fault", value_name = "FAULT")]
         faults: Vec<String>,
+        /// Hosts to run the robots on.
+        #[command(flatten)]
+        hosts: HostsArgs,
     },
     /// Drive a live run from another terminal: list its robots, kill, freeze or thaw one.
     Ctl {
@@ -69,6 +79,9 @@ enum Commands {
     /// Benchmark: the whole system at ARGoS' obstacle-avoidance density (one process per robot), the bare
     /// lockstep transport, and a real-time check; prints Markdown tables and writes <out>/bench.json.
     Bench(BenchArgs),
+    /// Run this machine's share of multi-host runs: announce this host, start the robots the world assigns it,
+    /// and bridge their frames and commands over zenoh.
+    Host(HostCli),
 }
 
 /// What `swarm ctl` asks a live run.
@@ -123,6 +136,35 @@ struct BenchArgs {
     /// Ticks of the real-time check.
     #[arg(long, default_value_t = swarm_runtime::bench::DEFAULT_REAL_TIME_TICKS)]
     real_time_ticks: u64,
+}
+
+/// Flags of `swarm host`.
+#[derive(Debug, Args)]
+struct HostCli {
+    /// The world's zenoh endpoint, e.g. tcp/10.0.0.1:7447.
+    #[arg(long)]
+    connect: String,
+    /// Name of this host in placements (default: the machine's host name, dots as '-').
+    #[arg(long)]
+    name: Option<String>,
+    /// Most robots this host accepts in one run.
+    #[arg(long, default_value_t = 1000)]
+    capacity: u32,
+    /// Link lease in milliseconds: a frozen or cut-off host is noticed after about this long.
+    #[arg(long = "lease-ms", default_value_t = DEFAULT_LEASE.as_millis() as u64)]
+    lease_ms: u64,
+    /// A zenoh configuration file (JSON5) to start from (e.g. for TLS).
+    #[arg(long = "zenoh-config")]
+    zenoh_config: Option<PathBuf>,
+    /// zenoh user name (with --password-file).
+    #[arg(long, requires = "password_file")]
+    user: Option<String>,
+    /// File holding the zenoh password.
+    #[arg(long = "password-file", requires = "user")]
+    password_file: Option<PathBuf>,
+    /// Folder for the agents' logs (default: <temp>/swarm-host-<name>).
+    #[arg(long)]
+    logs: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -184,6 +226,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             no_progress,
             real_time,
             faults,
+            hosts,
         } => {
             let stop = Arc::new(AtomicBool::new(false));
             let flag = Arc::clone(&stop);
@@ -199,6 +242,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 tick_deadline: tick_deadline_ms.map(Duration::from_millis),
                 real_time,
                 faults,
+                hosts,
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;
@@ -227,6 +271,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Commands::Ctl { run, request } => ctl(&run, request),
+        Commands::Host(cli) => run_host(cli),
     }
 }
 
@@ -242,4 +287,55 @@ fn ctl(run: &std::path::Path, request: CtlRequestArg) -> anyhow::Result<()> {
         .with_context(|| format!("swarm ctl {} {command}", run.display()))?;
     print!("{answer}");
     Ok(())
+}
+
+/// `swarm host`: serves runs until Ctrl-C or SIGTERM.
+fn run_host(cli: HostCli) -> anyhow::Result<()> {
+    let name = match cli.name {
+        Some(name) => name,
+        // Host names are one zenoh key chunk: dots and other characters become '-'.
+        None => std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .context("reading the machine's host name (or pass --name)")?
+            .trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '_' {
+                    c
+                } else {
+                    '-'
+                }
+            })
+            .collect(),
+    };
+    let password = match &cli.password_file {
+        Some(path) => Some(
+            std::fs::read_to_string(path)
+                .with_context(|| format!("reading the password file {}", path.display()))?
+                .trim_end_matches(['\r', '\n'])
+                .to_owned(),
+        ),
+        None => None,
+    };
+    let logs = cli
+        .logs
+        .unwrap_or_else(|| std::env::temp_dir().join(format!("swarm-host-{name}")));
+    let options = HostOptions {
+        connect: cli.connect,
+        capacity: cli.capacity,
+        zenoh: ZenohOptions {
+            config_file: cli.zenoh_config,
+            lease: Duration::from_millis(cli.lease_ms),
+            user: cli.user,
+            password,
+            credentials_file: None,
+        },
+        max_payload: DEFAULT_MAX_PAYLOAD,
+        logs,
+        name,
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    host::serve(&options, &stop).with_context(|| format!("host '{}'", options.name))
 }

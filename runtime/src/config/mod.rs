@@ -11,6 +11,7 @@
 
 pub mod diagnostic;
 pub mod faults;
+pub mod hosts;
 pub mod model;
 mod parse;
 mod registry;

@@ -17,11 +17,12 @@
 
 mod agents;
 pub mod binaries;
-mod children;
+pub(crate) mod children;
 pub mod control;
 mod fault_handling;
 pub mod fault_log;
 pub mod faults;
+pub mod hosts;
 pub mod process_args;
 pub mod records;
 pub mod restart;
@@ -85,6 +86,8 @@ pub struct RunOptions {
     pub real_time: bool,
     /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
     pub faults: Vec<String>,
+    /// Hosts to run the robots on instead of locally (see [`hosts`]).
+    pub hosts: hosts::HostsArgs,
 }
 
 /// What a finished run reports.
@@ -142,6 +145,9 @@ pub enum LaunchError {
     /// The world or agent programs are missing.
     #[error(transparent)]
     Binaries(#[from] BinariesError),
+    /// The hosts of the run cannot be resolved.
+    #[error(transparent)]
+    Hosts(#[from] hosts::HostsError),
     /// A file or process operation failed.
     #[error("{what}: {source}")]
     Io {
@@ -223,6 +229,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .ticks
         .or(experiment.framework.max_ticks())
         .unwrap_or(0);
+    let placement =
+        hosts::HostsPlan::resolve(&options.config, &options.hosts)?.map(|plan| plan.place(robots));
     let out_dir = run_dir::create(options.out.as_deref(), &options.config)
         .map_err(io("creating the run directory"))?;
     let binaries = Binaries::locate()?;
@@ -275,6 +283,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let mut world = children::spawn(
         Command::new(&binaries.world)
             .args(world_args.to_args())
+            .args(options.hosts.to_args())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped()),
     )
@@ -285,6 +294,12 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     children.world = Some(world);
 
     wait_ready(&mut children, &reports, robots)?;
+    // With hosts, each host daemon starts its own robots' agents; the world waits for them.
+    if let Some(placement) = &placement {
+        for share in placement {
+            tracing::info!(host = share.name, robots = share.robots.len(), "placed");
+        }
+    }
     let control = match ControlServer::listen(&out_dir) {
         Ok(server) => Some(server),
         Err(e) => {
@@ -333,7 +348,9 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         pending_restarts: Vec::new(),
         control,
     };
-    supervision.start_agents(&startup)?;
+    if placement.is_none() {
+        supervision.start_agents(&startup)?;
+    }
     let agent_pids: Vec<u32> = supervision.robots.iter().map(|r| r.first_pid).collect();
     let followed = supervision.follow(&reports, &stop);
     if let Err(error) = followed {

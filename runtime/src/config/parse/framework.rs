@@ -1,9 +1,10 @@
-//! `<framework>`: `<system threads>` and `<experiment length ticks_per_second random_seed>`.
+//! `<framework>`: `<system threads>`, `<experiment length ticks_per_second random_seed>` and `<hosts>` (checked
+//! here, read by [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
 
 use super::Ctx;
 use crate::config::model::{Element, Framework, Location};
 
-const CHILDREN: &[&str] = &["system", "experiment", "profiling"];
+const CHILDREN: &[&str] = &["system", "experiment", "profiling", "hosts"];
 
 /// Parses `<framework>`.
 pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
@@ -30,6 +31,12 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
                 "<profiling> is ignored: use `cargo bench` and the run log",
                 None,
             ),
+            "hosts" => {
+                let (_, errors) = crate::config::hosts::parse(child, std::path::Path::new("."));
+                for (at, message) in errors {
+                    ctx.error(at, message, None);
+                }
+            }
             _ => ctx.unknown_element(child, &el.name, CHILDREN),
         }
     }

@@ -4,12 +4,15 @@
 //! waits for the agents, then runs the lockstep: sense every robot into the shared frames, wake the agents, wait
 //! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
 //! Progress goes to standard output as [`WorldReport`] lines for the launcher; the launcher's lines on standard
-//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`]. SIGINT/SIGTERM end the run after the current tick with every record
-//! flushed. Normally started by `swarm run`; the flags are documented by `swarm-world --help`.
+//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`].
+//! SIGINT/SIGTERM end the run after the current tick with every record flushed. Normally started by `swarm run`;
+//! the flags are documented by `swarm-world --help`. With hosts (`--hosts` or `<hosts>`), the robots run on
+//! `swarm host` daemons reached over zenoh instead ([`remote`]).
 
 mod events;
 mod faults;
 mod pacing;
+mod remote;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -21,6 +24,7 @@ use anyhow::Context;
 use clap::Parser;
 use swarm_runtime::config::Experiment;
 use swarm_runtime::config::faults::FaultSchedule;
+use swarm_runtime::launcher::hosts::{HostsArgs, HostsPlan};
 use swarm_runtime::launcher::process_args::WorldArgs;
 use swarm_runtime::launcher::world_report::WorldReport;
 use swarm_runtime::messages::ActuatorCommand;
@@ -31,6 +35,7 @@ use swarm_world::recorder::Recorder;
 use events::EventsWriter;
 use faults::FaultDriver;
 use pacing::Pacer;
+use remote::Link;
 
 /// Minimum interval between two progress reports to the launcher.
 const REPORT_INTERVAL: Duration = Duration::from_millis(50);
@@ -41,11 +46,14 @@ const REPORT_INTERVAL: Duration = Duration::from_millis(50);
 struct Cli {
     #[command(flatten)]
     args: WorldArgs,
+    #[command(flatten)]
+    hosts: HostsArgs,
 }
 
 fn main() -> ExitCode {
     swarm_runtime::logging::init("info");
-    match run(&Cli::parse().args) {
+    let cli = Cli::parse();
+    match run(&cli.args, &cli.hosts) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("swarm-world: error: {e:#}");
@@ -61,7 +69,7 @@ fn report(line: WorldReport) {
     let _ = out.flush();
 }
 
-fn run(args: &WorldArgs) -> anyhow::Result<()> {
+fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
@@ -92,17 +100,33 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     if let Some(ms) = args.tick_deadline_ms {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
-    let mut link = WorldLink::create(&run, link_config)?;
-    let launcher = faults::follow_launcher(link.death_notices());
-    let mut faults = FaultDriver::new(
-        &schedule,
-        experiment.framework.ticks_per_second,
-        args.seed,
-        robots,
-        launcher,
-        args.out.clone(),
-        Duration::from_millis(args.join_timeout_ms),
-    );
+    // Local agents are supervised through the fault driver; hosts supervise their own agents.
+    let (mut link, mut faults) = match HostsPlan::resolve(&args.config, hosts)? {
+        None => {
+            let link = WorldLink::create(&run, link_config)?;
+            let launcher = faults::follow_launcher(link.death_notices());
+            let driver = FaultDriver::new(
+                &schedule,
+                experiment.framework.ticks_per_second,
+                args.seed,
+                robots,
+                launcher,
+                args.out.clone(),
+                Duration::from_millis(args.join_timeout_ms),
+            );
+            (Link::Local(link), Some(driver))
+        }
+        Some(plan) => {
+            anyhow::ensure!(
+                schedule.is_empty(),
+                "{}: fault schedules and restart policies are not supported in multi-host runs yet",
+                args.config.display()
+            );
+            let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
+            let link = Link::remote(plan, args, controllers, link_config.tick_deadline)?;
+            (link, None)
+        }
+    };
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
     let mut events = EventsWriter::create(&args.out, &roster)?;
     recorder.record_initial(&world)?;
@@ -113,7 +137,12 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
-    faults.wait_for_agents(&mut link, &mut world, &mut events, &commands)?;
+    match (&mut faults, &mut link) {
+        (Some(driver), Link::Local(local)) => {
+            driver.wait_for_agents(local, &mut world, &mut events, &commands)?;
+        }
+        _ => link.wait(Duration::from_millis(args.join_timeout_ms))?,
+    }
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -124,19 +153,18 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         && !world.is_finished()
         && (args.ticks == 0 || link.tick() < args.ticks)
     {
-        faults.before_tick(
-            link.tick() + 1,
-            &mut link,
-            &mut world,
-            &mut events,
-            &commands,
-        )?;
+        match (&mut faults, &mut link) {
+            (Some(driver), Link::Local(local)) => {
+                driver.before_tick(local.tick() + 1, local, &mut world, &mut events, &commands)?;
+            }
+            _ => link.apply_life_changes(&mut world),
+        }
         let tick_started = Instant::now();
         let outcome = link.tick_with(|_, frames| world.sense(frames))?;
         for robot in 0..robots {
             match link
                 .command(robot as u32)
-                .filter(|_| faults.is_alive(robot))
+                .filter(|_| faults.as_ref().is_none_or(|driver| driver.is_alive(robot)))
             {
                 Some(command) => {
                     commands[robot] = *command;
@@ -164,15 +192,22 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     }
     let ticking = started.elapsed().as_secs_f64();
     let ticks = link.tick();
-    let extra = serde_json::json!({
+    let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
         "ticking_seconds": ticking,
         "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
         "real_time": pacer.summary(ticks),
-        "alive_final": faults.alive_count(),
     });
+    if let Some(object) = extra.as_object_mut() {
+        if let Some(driver) = &faults {
+            object.insert("alive_final".into(), driver.alive_count().into());
+        }
+        if let Some(hosts) = link.summary() {
+            object.insert("hosts".into(), hosts);
+        }
+    }
     recorder.finish(&world, extra)?;
     events.flush()?;
     report(WorldReport::Finished { ticks });

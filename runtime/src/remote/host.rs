@@ -1,0 +1,526 @@
+//! `swarm host`: the daemon that runs one machine's share of multi-host runs.
+//!
+//! It announces itself with a liveliness token, waits for an [`Assignment`] on its queryable, and runs the share as
+//! a local lockstep run: its own iceoryx2 prefix and root, one `robot-agent` process per robot (told its run-wide
+//! id for its random stream and profile, and its local slot in this host's transport). Per tick it takes the
+//! newest frames message of its share, runs one local tick with those frames, and publishes its robots' replies.
+//! An agent that dies is reported `Dead` from then on (the same semantics as a single-host run). When the world's
+//! liveliness token goes (the run ended or the world died) or a new assignment arrives (the host rejoined), the
+//! share is stopped: agents are told to end, then killed, and every shared-memory file is removed.
+//!
+//! It must never answer for a robot of another host (its replies carry exactly its share) and never let a stale
+//! or malformed message reach its agents (dropped and counted).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::time::{Duration, Instant};
+
+use zenoh::Session;
+use zenoh::Wait;
+use zenoh::liveliness::LivelinessToken;
+use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::qos::CongestionControl;
+use zenoh::query::{Query, Queryable};
+use zenoh::sample::SampleKind;
+
+use super::assignment::{Assignment, AssignmentReply};
+use super::codec::{self, Header, Kind, Reply};
+use super::session::{ZenohOptions, zenoh_error};
+use super::{RemoteError, keys};
+use crate::launcher::binaries::Binaries;
+use crate::launcher::children::{self, Children};
+use crate::launcher::process_args::{AgentArgs, RunArgs};
+use crate::launcher::run_dir;
+use crate::messages::SensorFrame;
+use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink};
+
+/// How long agents get to exit by themselves when a share ends.
+const AGENT_EXIT_GRACE: Duration = Duration::from_secs(2);
+/// How often the daemon looks at its agents when no message arrives.
+const IDLE_PERIOD: Duration = Duration::from_millis(50);
+/// Lines of an agent's log quoted when it fails to start.
+const LOG_LINES_QUOTED: usize = 8;
+
+/// What `swarm host` was asked to do.
+#[derive(Debug, Clone)]
+pub struct HostOptions {
+    /// Host name (its liveliness token and keys).
+    pub name: String,
+    /// The world's zenoh endpoint, e.g. `tcp/10.0.0.1:7447`.
+    pub connect: String,
+    /// Most robots this host accepts in one run.
+    pub capacity: u32,
+    /// Session settings.
+    pub zenoh: ZenohOptions,
+    /// Largest payload accepted.
+    pub max_payload: usize,
+    /// Folder for the agents' logs (`robot-<id>.log`).
+    pub logs: PathBuf,
+}
+
+/// What reaches the daemon's loop from zenoh's callbacks.
+enum Event {
+    /// A new share.
+    Assign(Query),
+    /// A frames message of run `run`.
+    Frames { run: u64, bytes: Vec<u8> },
+    /// The world of run `run` is gone.
+    WorldGone { run: u64 },
+}
+
+/// Counters of dropped messages, logged when a share ends.
+#[derive(Debug, Default, Clone, Copy)]
+struct Dropped {
+    stale: u64,
+    malformed: u64,
+}
+
+/// Runs the daemon until `stop` is set.
+pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError> {
+    keys::check_host_name(&options.name)?;
+    let binaries = Binaries::locate()?;
+    std::fs::create_dir_all(&options.logs).map_err(|source| RemoteError::Io {
+        what: format!("creating {}", options.logs.display()),
+        source,
+    })?;
+    tracing::info!(
+        host = options.name,
+        endpoint = options.connect,
+        "connecting"
+    );
+    let Some(session) = connect(options, stop)? else {
+        return Ok(());
+    };
+    let (sender, events) = mpsc::channel();
+    let assign_sender = sender.clone();
+    let _queryable: Queryable<()> = session
+        .declare_queryable(keys::assign(&options.name))
+        .callback(move |query| {
+            let _ = assign_sender.send(Event::Assign(query));
+        })
+        .wait()
+        .map_err(zenoh_error("declaring the assignment queryable"))?;
+    let _token: LivelinessToken = session
+        .liveliness()
+        .declare_token(keys::host_token(&options.name))
+        .wait()
+        .map_err(zenoh_error("declaring the host's liveliness token"))?;
+    tracing::info!(
+        host = options.name,
+        capacity = options.capacity,
+        "ready for runs"
+    );
+
+    let mut share: Option<Share> = None;
+    while !stop.load(Ordering::Relaxed) {
+        let event = match events.recv_timeout(IDLE_PERIOD) {
+            Ok(event) => Some(event),
+            Err(RecvTimeoutError::Timeout) => None,
+            Err(RecvTimeoutError::Disconnected) => break,
+        };
+        match event {
+            Some(Event::Assign(query)) => {
+                // A new assignment replaces the current share (the host rejoined after a loss).
+                drop(share.take());
+                share = accept(&session, options, &binaries, &query, &sender);
+            }
+            Some(Event::Frames { run, bytes }) => {
+                if let Some(current) = share.as_mut().filter(|s| s.assignment.run == run) {
+                    let newest = newest_frames(&events, &sender, run, bytes, &mut current.dropped);
+                    if let Err(e) = current.tick(&newest, options.max_payload) {
+                        tracing::error!(run = format!("{run:016x}"), "ending the share: {e}");
+                        share = None;
+                    }
+                }
+            }
+            Some(Event::WorldGone { run })
+                if share.as_ref().is_some_and(|s| s.assignment.run == run) =>
+            {
+                tracing::info!(run = format!("{run:016x}"), "the world ended the run");
+                share = None;
+            }
+            Some(Event::WorldGone { .. }) | None => {}
+        }
+        if let Some(current) = share.as_mut() {
+            current.reap();
+        }
+    }
+    drop(share);
+    session
+        .close()
+        .wait()
+        .map_err(zenoh_error("closing the session"))
+}
+
+/// Opens the host's session; zenoh's client mode blocks until the world's endpoint answers, so it runs on a thread
+/// while this one watches `stop`. `None` when stopped first.
+fn connect(options: &HostOptions, stop: &AtomicBool) -> Result<Option<Session>, RemoteError> {
+    let (sender, opened) = mpsc::channel();
+    let zenoh = options.zenoh.clone();
+    let endpoint = options.connect.clone();
+    std::thread::spawn(move || {
+        let _ = sender.send(zenoh.open_host(&endpoint));
+    });
+    loop {
+        match opened.recv_timeout(IDLE_PERIOD) {
+            Ok(session) => return session.map(Some),
+            Err(RecvTimeoutError::Timeout) if stop.load(Ordering::Relaxed) => return Ok(None),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(RemoteError::Zenoh {
+                    action: format!("connecting to {}", options.connect),
+                    detail: "the connecting thread ended without a session".into(),
+                });
+            }
+        }
+    }
+}
+
+/// Takes every frames message already queued: the newest of `run` wins, older ones count as stale; other events
+/// are put back in order.
+fn newest_frames(
+    events: &Receiver<Event>,
+    sender: &Sender<Event>,
+    run: u64,
+    first: Vec<u8>,
+    dropped: &mut Dropped,
+) -> Vec<u8> {
+    let mut newest = first;
+    let mut others = Vec::new();
+    while let Ok(event) = events.try_recv() {
+        match event {
+            Event::Frames { run: r, bytes } if r == run => {
+                dropped.stale += 1;
+                newest = bytes;
+            }
+            other => others.push(other),
+        }
+    }
+    for other in others {
+        let _ = sender.send(other);
+    }
+    newest
+}
+
+/// Answers an assignment query: starts the share, or refuses with the reason.
+fn accept(
+    session: &Session,
+    options: &HostOptions,
+    binaries: &Binaries,
+    query: &Query,
+    sender: &Sender<Event>,
+) -> Option<Share> {
+    let assignment = match query.payload() {
+        Some(payload) => {
+            codec::decode_message::<Assignment>(&payload.to_bytes(), options.max_payload)
+        }
+        None => Err(codec::WireError::Malformed(
+            "an assignment without payload".into(),
+        )),
+    };
+    let (reply, share) = match assignment {
+        Err(e) => {
+            tracing::warn!("ignoring a malformed assignment: {e}");
+            (
+                AssignmentReply::Refused {
+                    epoch: 0,
+                    reason: format!("malformed assignment: {e}"),
+                },
+                None,
+            )
+        }
+        Ok(assignment) => {
+            let epoch = assignment.epoch;
+            match Share::start(session, options, binaries, assignment, sender) {
+                Ok(share) => (AssignmentReply::Ready { epoch }, Some(share)),
+                Err(e) => {
+                    tracing::error!("refusing the share: {e}");
+                    (
+                        AssignmentReply::Refused {
+                            epoch,
+                            reason: e.to_string(),
+                        },
+                        None,
+                    )
+                }
+            }
+        }
+    };
+    match codec::encode_message(&reply) {
+        Ok(bytes) => {
+            if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {
+                tracing::warn!("answering the assignment: {e}");
+            }
+        }
+        Err(e) => tracing::warn!("encoding the assignment reply: {e}"),
+    }
+    share
+}
+
+/// One run's share on this host.
+struct Share {
+    assignment: Assignment,
+    robots: Vec<u32>,
+    spec: RunSpec,
+    link: Option<WorldLink>,
+    children: Children,
+    frames: Vec<SensorFrame>,
+    replies: Vec<Reply>,
+    buf: Vec<u8>,
+    last_tick: u64,
+    dropped: Dropped,
+    publisher: Publisher<'static>,
+    _frames: Subscriber<()>,
+    _world: Subscriber<()>,
+}
+
+impl Share {
+    /// Creates the local run, starts one agent per robot and waits until all joined.
+    fn start(
+        session: &Session,
+        options: &HostOptions,
+        binaries: &Binaries,
+        assignment: Assignment,
+        sender: &Sender<Event>,
+    ) -> Result<Share, RemoteError> {
+        let count = assignment.robots.len() as u32;
+        if count > options.capacity {
+            return Err(RemoteError::Refused {
+                host: options.name.clone(),
+                reason: format!(
+                    "{count} robots exceed the host's capacity of {} (swarm host --capacity)",
+                    options.capacity
+                ),
+            });
+        }
+        if !assignment.config.is_file() {
+            return Err(RemoteError::Refused {
+                host: options.name.clone(),
+                reason: format!(
+                    "the configuration {} does not exist on this host (every host needs the experiment's files \
+                     at the same path)",
+                    assignment.config.display()
+                ),
+            });
+        }
+        let run = assignment.run;
+        let spec = RunSpec::unique();
+        let mut link_config = LinkConfig::new(count.max(1));
+        link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);
+        let link = WorldLink::create(&spec, link_config)?;
+        let publisher = session
+            .declare_publisher(keys::replies(run, &options.name))
+            .congestion_control(CongestionControl::Block)
+            .express(true)
+            .wait()
+            .map_err(zenoh_error("declaring the replies publisher"))?;
+        let frames_sender = sender.clone();
+        let frames = session
+            .declare_subscriber(keys::frames(run, &options.name))
+            .callback(move |sample| {
+                let bytes = sample.payload().to_bytes().into_owned();
+                let _ = frames_sender.send(Event::Frames { run, bytes });
+            })
+            .wait()
+            .map_err(zenoh_error("subscribing to the frames"))?;
+        let world_sender = sender.clone();
+        let world = session
+            .liveliness()
+            .declare_subscriber(keys::world_token(run))
+            .callback(move |sample| {
+                if sample.kind() == SampleKind::Delete {
+                    let _ = world_sender.send(Event::WorldGone { run });
+                }
+            })
+            .wait()
+            .map_err(zenoh_error("watching the world"))?;
+        let robots: Vec<u32> = assignment.robots.iter().map(|(id, _)| *id).collect();
+        let mut share = Share {
+            robots,
+            frames: vec![SensorFrame::empty(0); count as usize],
+            replies: vec![Reply::Missing; count as usize],
+            buf: Vec::new(),
+            last_tick: 0,
+            dropped: Dropped::default(),
+            spec,
+            link: Some(link),
+            children: Children::default(),
+            publisher,
+            _frames: frames,
+            _world: world,
+            assignment,
+        };
+        share.spawn_agents(&binaries.agent, &options.logs)?;
+        share.wait_joined(
+            Duration::from_millis(share.assignment.join_timeout_ms),
+            &options.logs,
+        )?;
+        tracing::info!(
+            run = format!("{run:016x}"),
+            epoch = share.assignment.epoch,
+            robots = count,
+            "share started"
+        );
+        Ok(share)
+    }
+
+    fn spawn_agents(&mut self, agent: &Path, logs: &Path) -> Result<(), RemoteError> {
+        let run = RunArgs {
+            run: self.spec.name().to_owned(),
+            iox_root: self.spec.root_dir().to_path_buf(),
+        };
+        for (slot, (robot, controller)) in self.assignment.robots.iter().enumerate() {
+            let args = AgentArgs {
+                run: run.clone(),
+                robot: *robot,
+                config: self.assignment.config.clone(),
+                controller: controller.clone(),
+                seed: self.assignment.seed,
+                robots: self.assignment.robots_override,
+            };
+            let log_path = log_file(logs, *robot);
+            let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
+                what: format!("creating {}", log_path.display()),
+                source,
+            })?;
+            let child = children::spawn(
+                Command::new(agent)
+                    .args(args.to_args())
+                    .args(["--slot", &slot.to_string()])
+                    .stdin(Stdio::null())
+                    .stdout(Stdio::null())
+                    .stderr(log),
+            )
+            .map_err(|source| RemoteError::Io {
+                what: format!("starting {}", agent.display()),
+                source,
+            })?;
+            self.children.agents.push(Some(child));
+        }
+        Ok(())
+    }
+
+    /// Waits for every agent to join; an agent that exits first fails the share with the end of its log.
+    fn wait_joined(&mut self, timeout: Duration, logs: &Path) -> Result<(), RemoteError> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let Some(link) = &self.link else {
+                return Ok(());
+            };
+            match link.wait_for_agents(IDLE_PERIOD) {
+                Ok(()) => return Ok(()),
+                Err(e) if Instant::now() >= deadline => return Err(e.into()),
+                Err(_) => {}
+            }
+            if let Some((slot, status)) = self.children.reap_agents().into_iter().next() {
+                let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
+                let log = run_dir::tail(&log_file(logs, robot), LOG_LINES_QUOTED);
+                return Err(RemoteError::Refused {
+                    host: self.assignment.name.clone(),
+                    reason: format!("robot {robot} failed to start ({status}):\n{log}"),
+                });
+            }
+        }
+    }
+
+    /// Reports agents that exited to the local transport, so their robots are `Dead` from now on.
+    fn reap(&mut self) {
+        let Some(link) = &self.link else { return };
+        for (slot, status) in self.children.reap_agents() {
+            let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
+            tracing::warn!(robot, %status, "robot agent died");
+            if let Err(e) = link.mark_dead(slot) {
+                tracing::warn!(robot, "reporting the death: {e}");
+            }
+        }
+    }
+
+    /// Runs one local tick with a frames message and publishes the replies.
+    fn tick(&mut self, bytes: &[u8], max_payload: usize) -> Result<(), RemoteError> {
+        let header = match codec::decode_batch(
+            bytes,
+            Kind::Frames,
+            &self.robots,
+            &mut self.frames,
+            max_payload,
+        ) {
+            Ok(header) => header,
+            Err(e) => {
+                self.dropped.malformed += 1;
+                tracing::debug!("dropping a frames message: {e}");
+                return Ok(());
+            }
+        };
+        if header.epoch != self.assignment.epoch
+            || header.host != self.assignment.host
+            || header.tick <= self.last_tick
+        {
+            self.dropped.stale += 1;
+            tracing::trace!(tick = header.tick, "dropping a stale frames message");
+            return Ok(());
+        }
+        self.reap();
+        let Some(link) = self.link.as_mut() else {
+            return Ok(());
+        };
+        let frames = &self.frames;
+        link.tick_with(|_, local| local.copy_from_slice(frames))?;
+        for (slot, reply) in self.replies.iter_mut().enumerate() {
+            *reply = match (link.statuses()[slot], link.command(slot as u32)) {
+                (CommandStatus::Answered, Some(command)) => {
+                    let mut command = *command;
+                    command.robot = self.robots[slot];
+                    command.tick = header.tick;
+                    Reply::Answered(command)
+                }
+                (CommandStatus::Dead, _) => Reply::Dead,
+                _ => Reply::Missing,
+            };
+        }
+        if self.last_tick == 0 {
+            tracing::info!(tick = header.tick, "first tick of the share");
+        }
+        self.last_tick = header.tick;
+        let out = Header::new(
+            Kind::Replies,
+            self.assignment.run,
+            self.assignment.host,
+            self.assignment.epoch,
+            header.tick,
+        );
+        codec::encode_batch(&mut self.buf, &out, &self.robots, &self.replies)?;
+        self.publisher
+            .put(self.buf.clone())
+            .wait()
+            .map_err(zenoh_error("publishing the replies"))
+    }
+}
+
+impl Drop for Share {
+    fn drop(&mut self) {
+        // Ending the local run tells the agents to exit; stragglers are killed after a grace period.
+        self.link = None;
+        let deadline = Instant::now() + AGENT_EXIT_GRACE;
+        while self.children.agents_running() > 0 && Instant::now() < deadline {
+            self.children.reap_agents();
+            std::thread::sleep(IDLE_PERIOD);
+        }
+        self.children.kill_all();
+        if let Err(e) = self.spec.cleanup() {
+            tracing::warn!("removing the share's shared memory: {e}");
+        }
+        tracing::info!(
+            run = format!("{:016x}", self.assignment.run),
+            last_tick = self.last_tick,
+            stale = self.dropped.stale,
+            malformed = self.dropped.malformed,
+            "share ended"
+        );
+    }
+}
+
+fn log_file(logs: &Path, robot: u32) -> PathBuf {
+    logs.join(format!("robot-{robot}.log"))
+}

@@ -1,0 +1,92 @@
+//! The zenoh key expressions of the cross-host protocol, built in one place so both ends agree.
+//!
+//! - `swarm/hosts/<host>`: a host daemon's liveliness token (it is up and reachable).
+//! - `swarm/hosts/<host>/assign`: the host's queryable; the world sends it its share of a run.
+//! - `swarm/runs/<run>/world`: the world's liveliness token while the run lasts (hosts end their share when it goes).
+//! - `swarm/runs/<run>/frames/<host>` and `swarm/runs/<run>/replies/<host>`: one message per host per tick each way.
+
+use super::RemoteError;
+
+/// Longest host name (it is one key chunk and part of log lines).
+pub const MAX_HOST_NAME: usize = 64;
+
+/// Checks that `name` can name a host: 1-64 ASCII letters, digits, `-` or `_`.
+pub fn check_host_name(name: &str) -> Result<(), RemoteError> {
+    if name.is_empty()
+        || name.len() > MAX_HOST_NAME
+        || !name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
+    {
+        return Err(RemoteError::InvalidHostName {
+            name: name.to_owned(),
+        });
+    }
+    Ok(())
+}
+
+/// Every host's liveliness token.
+pub const HOSTS_WILDCARD: &str = "swarm/hosts/*";
+
+/// Liveliness token of host `name`.
+pub fn host_token(name: &str) -> String {
+    format!("swarm/hosts/{name}")
+}
+
+/// The host name in a liveliness key of [`HOSTS_WILDCARD`], if it is one.
+pub fn host_of_token(key: &str) -> Option<&str> {
+    key.strip_prefix("swarm/hosts/")
+        .filter(|rest| !rest.contains('/'))
+}
+
+/// Queryable through which host `name` receives its share of a run.
+pub fn assign(name: &str) -> String {
+    format!("swarm/hosts/{name}/assign")
+}
+
+/// The world's liveliness token of run `run`.
+pub fn world_token(run: u64) -> String {
+    format!("swarm/runs/{run:016x}/world")
+}
+
+/// Frames of run `run` for host `name`.
+pub fn frames(run: u64, name: &str) -> String {
+    format!("swarm/runs/{run:016x}/frames/{name}")
+}
+
+/// Replies of host `name` in run `run`.
+pub fn replies(run: u64, name: &str) -> String {
+    format!("swarm/runs/{run:016x}/replies/{name}")
+}
+
+/// Every host's replies in run `run`.
+pub fn all_replies(run: u64) -> String {
+    format!("swarm/runs/{run:016x}/replies/*")
+}
+
+/// The host name in a key of [`all_replies`], if it is one.
+pub fn host_of_replies(key: &str) -> Option<&str> {
+    key.rsplit_once("/replies/").map(|(_, host)| host)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn host_names_are_one_key_chunk() {
+        for good in ["a", "host-1", "rack_2"] {
+            assert!(check_host_name(good).is_ok(), "{good}");
+        }
+        for bad in ["", "a/b", "*", "a b", "h$", &"x".repeat(65)] {
+            assert!(check_host_name(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn keys_give_back_their_host() {
+        assert_eq!(host_of_token(&host_token("h1")), Some("h1"));
+        assert_eq!(host_of_token(&assign("h1")), None);
+        assert_eq!(host_of_replies(&replies(7, "h2")), Some("h2"));
+    }
+}

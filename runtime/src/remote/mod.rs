@@ -1,0 +1,65 @@
+//! Across hosts: the world speaks zenoh with one `swarm host` daemon per machine; robots always speak iceoryx2.
+//!
+//! Each host daemon ([`host`]) announces itself with a zenoh liveliness token, receives its share of a run
+//! ([`assignment`]), runs it as a local lockstep run (its own iceoryx2 prefix and root, one agent process per
+//! robot) and bridges: per tick one message of its robots' frames in, one message of their replies out
+//! ([`codec`]). The world's side ([`world_bridge`]) publishes one batch per host per tick, waits for each host's
+//! batch with the tick deadline, and treats the robots of a lost host as dead from the tick it notices the loss.
+//! Key expressions are in [`keys`], session settings in [`session`]. docs/hosts.md explains the choices.
+//!
+//! A run with every robot local never opens a zenoh session.
+
+pub mod assignment;
+pub mod codec;
+pub mod host;
+pub mod keys;
+pub mod session;
+pub mod world_bridge;
+
+/// What can go wrong across hosts.
+#[derive(Debug, thiserror::Error)]
+pub enum RemoteError {
+    /// A host name that cannot be a key chunk.
+    #[error("invalid host name '{name}': use 1-64 ASCII letters, digits, '-' or '_'")]
+    InvalidHostName {
+        /// The rejected name.
+        name: String,
+    },
+    /// A zenoh operation failed.
+    #[error("zenoh: {action}: {detail}")]
+    Zenoh {
+        /// What was being done.
+        action: String,
+        /// zenoh's error.
+        detail: String,
+    },
+    /// A payload could not be encoded.
+    #[error("encoding a message: {0}")]
+    Wire(#[from] codec::WireError),
+    /// The local transport of a host failed.
+    #[error(transparent)]
+    Transport(#[from] crate::transport::TransportError),
+    /// A host refused its share of the run.
+    #[error("host '{host}' refused its share of the run: {reason}")]
+    Refused {
+        /// The host.
+        host: String,
+        /// Its reason.
+        reason: String,
+    },
+    /// Hosts did not join in time.
+    #[error("{0}")]
+    HostsMissing(String),
+    /// The robot-agent program is missing.
+    #[error(transparent)]
+    Binaries(#[from] crate::launcher::binaries::BinariesError),
+    /// A file or process operation failed.
+    #[error("{what}: {source}")]
+    Io {
+        /// What was being done.
+        what: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+}

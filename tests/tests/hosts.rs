@@ -1,0 +1,351 @@
+//! `swarm run` across hosts: real `swarm host` daemons, each in its own Linux network namespace joined by a veth pair
+//! (root and iproute2 needed; otherwise the tests say so loudly and run the hosts on loopback), each with its own
+//! iceoryx2 prefix and root, speaking zenoh with the world.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::Receiver;
+use std::time::Duration;
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+use swarm_system_tests::{
+    HostDaemon, Netns, assert_clean, bin_dir, follow_lines, free_port, shm_leftovers, swarm,
+    wait_for_line, workspace_root,
+};
+
+const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
+/// Robots of the fault tests' runs.
+const RUN_ROBOTS: usize = 6;
+/// Generous bound for events that take milliseconds to seconds (process start-up under a loaded machine).
+const EVENT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Where the hosts of a test run: network namespaces when possible, else loopback (said loudly).
+struct Hosts {
+    daemons: Vec<HostDaemon>,
+    namespaces: Vec<Netns>,
+    listen: Vec<String>,
+}
+
+impl Hosts {
+    fn start(names: &[&str]) -> Hosts {
+        let namespaces: Result<Vec<Netns>, String> =
+            (0..names.len() as u32).map(Netns::create).collect();
+        match namespaces {
+            Ok(namespaces) => {
+                let mut listen = Vec::new();
+                let mut daemons = Vec::new();
+                for (name, ns) in names.iter().zip(&namespaces) {
+                    let endpoint = format!("tcp/{}:{}", ns.outer_ip, free_port(&ns.outer_ip));
+                    daemons.push(HostDaemon::start(name, &endpoint, Some(&ns.name)));
+                    listen.push(endpoint);
+                }
+                Hosts {
+                    daemons,
+                    namespaces,
+                    listen,
+                }
+            }
+            Err(reason) => {
+                eprintln!(
+                    "\n*** SKIPPED network namespaces ({reason}): the hosts run on loopback instead ***\n"
+                );
+                let endpoint = format!("tcp/127.0.0.1:{}", free_port("127.0.0.1"));
+                Hosts {
+                    daemons: names
+                        .iter()
+                        .map(|name| HostDaemon::start(name, &endpoint, None))
+                        .collect(),
+                    namespaces: Vec::new(),
+                    listen: vec![endpoint],
+                }
+            }
+        }
+    }
+
+    /// `--hosts a,b --listen ...` for `swarm run`.
+    fn run_args(&self) -> Vec<String> {
+        let names: Vec<&str> = self.daemons.iter().map(|d| d.name.as_str()).collect();
+        let mut args = vec!["--hosts".to_owned(), names.join(",")];
+        for endpoint in &self.listen {
+            args.extend(["--listen".to_owned(), endpoint.clone()]);
+        }
+        args
+    }
+
+    /// Restarts daemon `i` under the same name (in its namespace, if any).
+    fn restart(&mut self, i: usize) {
+        let name = self.daemons[i].name.clone();
+        let endpoint = self.listen[i.min(self.listen.len() - 1)].clone();
+        let ns = self.namespaces.get(i).map(|n| n.name.clone());
+        self.daemons[i] = HostDaemon::start(&name, &endpoint, ns.as_deref());
+    }
+
+    /// Stops every daemon gracefully and checks it left no process and no shared memory.
+    fn stop_and_check_clean(mut self) {
+        for daemon in &mut self.daemons {
+            let pid = daemon.pid();
+            assert!(
+                daemon.stop(),
+                "host {} did not stop cleanly:\n{}",
+                daemon.name,
+                daemon.log()
+            );
+            assert_eq!(
+                shm_leftovers(&format!("sw{pid:x}-")),
+                Vec::<std::path::PathBuf>::new(),
+                "host {}'s shared memory outlived it",
+                daemon.name
+            );
+        }
+    }
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json exists");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+fn read(out: &Path, name: &str) -> Vec<u8> {
+    std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
+    let common = [
+        "--robots",
+        "10",
+        "--ticks",
+        "150",
+        "--seed",
+        "11",
+        "--no-progress",
+    ];
+    let single = tempfile::tempdir().expect("a temporary directory");
+    let out = single.path().display().to_string();
+    let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
+    args.extend(common);
+    let outcome = swarm(&args);
+    assert!(
+        outcome.output.status.success(),
+        "single-host run failed:\n{}",
+        outcome.stderr()
+    );
+
+    let hosts = Hosts::start(&["alpha", "beta"]);
+    let multi = tempfile::tempdir().expect("a temporary directory");
+    let out = multi.path().display().to_string();
+    let host_args = hosts.run_args();
+    let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
+    args.extend(common);
+    args.extend(host_args.iter().map(String::as_str));
+    let outcome = swarm(&args);
+    assert!(
+        outcome.output.status.success(),
+        "two-host run failed:\n{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+
+    let summary = summary(multi.path());
+    assert_eq!(summary["ticks"], 150);
+    let shares = summary["hosts"]["hosts"]
+        .as_array()
+        .expect("hosts in the summary");
+    let sizes: Vec<usize> = shares
+        .iter()
+        .map(|h| h["robots"].as_array().map_or(0, Vec::len))
+        .collect();
+    assert_eq!(sizes, [5, 5], "10 robots shared equally by two hosts");
+    assert_eq!(
+        summary["processes"]["agents"].as_array().map(Vec::len),
+        Some(0),
+        "the launcher started no local agent"
+    );
+    assert!(
+        read(single.path(), "trajectory.csv") == read(multi.path(), "trajectory.csv"),
+        "trajectory.csv of the two-host run differs from the single-host run with the same seed"
+    );
+    assert!(
+        read(single.path(), "events.csv") == read(multi.path(), "events.csv"),
+        "events.csv of the two-host run differs from the single-host run with the same seed"
+    );
+    hosts.stop_and_check_clean();
+}
+
+/// A `swarm run` in the background whose log lines the test follows.
+struct BackgroundRun {
+    child: Child,
+    lines: Receiver<String>,
+    seen: Vec<String>,
+}
+
+impl BackgroundRun {
+    fn start(out: &Path, hosts: &Hosts) -> BackgroundRun {
+        let dir = bin_dir();
+        let mut child = Command::new(dir.join("swarm"))
+            .args([
+                "run",
+                OBSTACLE_AVOIDANCE,
+                "--robots",
+                &RUN_ROBOTS.to_string(),
+            ])
+            .args(["--ticks", "0", "--seed", "3"])
+            .args(["--tick-deadline-ms", "200", "--no-progress", "--out"])
+            .arg(out)
+            .args(hosts.run_args())
+            .env("SWARM_BIN_DIR", dir)
+            .env("RUST_LOG", "info,zenoh=warn")
+            .current_dir(workspace_root())
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("swarm starts");
+        let lines = follow_lines(child.stderr.take());
+        BackgroundRun {
+            child,
+            lines,
+            seen: Vec::new(),
+        }
+    }
+
+    fn wait_for(&mut self, needle: &str) {
+        assert!(
+            wait_for_line(&self.lines, &mut self.seen, needle, EVENT_TIMEOUT),
+            "the run never logged {needle:?}:\n{}",
+            self.seen.join("\n")
+        );
+    }
+
+    /// Interrupts the run (it finishes its tick and flushes) and checks it ended successfully.
+    fn interrupt(mut self) {
+        kill(Pid::from_raw(self.child.id() as i32), Signal::SIGINT)
+            .expect("interrupt the launcher");
+        let status = self.child.wait().expect("the launcher exits");
+        while let Ok(line) = self.lines.recv_timeout(Duration::from_secs(5)) {
+            self.seen.push(line);
+        }
+        assert!(
+            status.success(),
+            "the run failed:\n{}",
+            self.seen.join("\n")
+        );
+    }
+}
+
+impl Drop for BackgroundRun {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The alive flags of robot `robot` (of `robots`) in tick order, from trajectory.csv (one row per robot per tick,
+/// in robot order).
+fn alive_over_time(out: &Path, robot: usize, robots: usize) -> Vec<(u64, bool)> {
+    let text = String::from_utf8(read(out, "trajectory.csv")).expect("UTF-8");
+    text.lines()
+        .skip(1)
+        .skip(robot)
+        .step_by(robots)
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            let tick = fields[0].parse().expect("a tick");
+            (tick, fields.last() == Some(&"1"))
+        })
+        .collect()
+}
+
+/// Checks the summary recorded one loss and one return of host 1 and that its first robot died and came back at
+/// those ticks while host 0's robots lived throughout. The world applies a decision between ticks, so the record
+/// shows a robot dead from the tick after the loss and alive from the tick after its host's first answer.
+fn assert_lost_and_rejoined(out: &Path) {
+    let summary = summary(out);
+    let host = &summary["hosts"]["hosts"][1];
+    let lost: Vec<u64> = serde_json::from_value(host["lost_at_ticks"].clone()).expect("lost ticks");
+    let back: Vec<u64> =
+        serde_json::from_value(host["rejoined_at_ticks"].clone()).expect("rejoin ticks");
+    assert_eq!(lost.len(), 1, "one loss recorded: {summary}");
+    assert_eq!(back.len(), 1, "one return recorded: {summary}");
+    assert!(
+        lost[0] < back[0],
+        "lost at {} before back at {}",
+        lost[0],
+        back[0]
+    );
+    let robot = host["robots"][0].as_u64().expect("a robot id") as usize;
+    for (tick, alive) in alive_over_time(out, robot, RUN_ROBOTS) {
+        let expected = tick <= lost[0] || tick > back[0];
+        assert_eq!(
+            alive, expected,
+            "robot {robot} alive at tick {tick} (lost {}, back {})",
+            lost[0], back[0]
+        );
+    }
+    let other = summary["hosts"]["hosts"][0]["robots"][0]
+        .as_u64()
+        .expect("a robot id") as usize;
+    assert!(
+        alive_over_time(out, other, RUN_ROBOTS)
+            .iter()
+            .all(|(_, alive)| *alive),
+        "host 0's robots lived throughout"
+    );
+}
+
+#[test]
+fn a_killed_host_is_lost_its_robots_die_and_a_restarted_one_rejoins() {
+    let mut hosts = Hosts::start(&["gamma", "delta"]);
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let mut run = BackgroundRun::start(out.path(), &hosts);
+    assert!(
+        hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
+        "host delta never ticked:\n{}",
+        hosts.daemons[1].log()
+    );
+    hosts.daemons[1].kill();
+    run.wait_for("host lost");
+    hosts.restart(1);
+    run.wait_for("host rejoined");
+    assert!(
+        hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
+        "the restarted host never ticked:\n{}",
+        hosts.daemons[1].log()
+    );
+    run.interrupt();
+    assert_lost_and_rejoined(out.path());
+    hosts.stop_and_check_clean();
+}
+
+#[test]
+fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns() {
+    let mut hosts = Hosts::start(&["epsilon", "zeta"]);
+    if hosts.namespaces.is_empty() {
+        eprintln!(
+            "\n*** SKIPPED partition test: it needs network namespaces to cut a host's link ***\n"
+        );
+        return;
+    }
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let mut run = BackgroundRun::start(out.path(), &hosts);
+    assert!(
+        hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
+        "host zeta never ticked:\n{}",
+        hosts.daemons[1].log()
+    );
+    hosts.namespaces[1].set_link(false).expect("cut the link");
+    run.wait_for("host lost");
+    hosts.namespaces[1]
+        .set_link(true)
+        .expect("restore the link");
+    run.wait_for("host rejoined");
+    assert!(
+        hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
+        "the host never ticked after its link returned:\n{}",
+        hosts.daemons[1].log()
+    );
+    run.interrupt();
+    assert_lost_and_rejoined(out.path());
+    hosts.stop_and_check_clean();
+}
