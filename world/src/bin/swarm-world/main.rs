@@ -93,6 +93,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
     let mut link = WorldLink::create(&run, link_config)?;
     let launcher = faults::follow_launcher(link.death_notices());
     let mut faults = FaultDriver::new(
+        &link,
         &schedule,
         experiment.framework.ticks_per_second,
         args.seed,
@@ -100,7 +101,7 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         launcher,
         args.out.clone(),
         Duration::from_millis(args.join_timeout_ms),
-    );
+    )?;
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
     let mut events = EventsWriter::create(&args.out, &roster)?;
     recorder.record_initial(&world)?;
