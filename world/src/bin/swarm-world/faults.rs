@@ -113,11 +113,11 @@ impl FaultDriver {
         schedule: &FaultSchedule,
         ticks_per_second: u32,
         seed: u64,
-        robots: usize,
         commands: Receiver<WorldCommand>,
         out_dir: PathBuf,
         join_timeout: Duration,
     ) -> anyhow::Result<FaultDriver> {
+        let robots = link.config().robots as usize;
         for robot in 0..robots as u32 {
             link.mark_dead(robot)?;
         }
@@ -373,11 +373,13 @@ impl FaultDriver {
         }
         .write(&self.out_dir)?;
         // Scheduled faults get their own row from the schedule.
-        match cause {
-            Down::Killed | Down::Frozen => Ok(()),
-            Down::Notice => Ok(events.record_fault(tick, robot as usize, "fault:down")?),
-            Down::Deadline => Ok(events.record_fault(tick, robot as usize, "fault:missed")?),
-        }
+        let name = match cause {
+            Down::Killed | Down::Frozen => return Ok(()),
+            Down::Notice => "fault:down",
+            Down::Deadline => "fault:missed",
+        };
+        events.record_fault(tick, robot as usize, name)?;
+        Ok(())
     }
 
     /// `robot` takes part again from `tick`.

@@ -97,7 +97,6 @@ fn run(args: &WorldArgs) -> anyhow::Result<()> {
         &schedule,
         experiment.framework.ticks_per_second,
         args.seed,
-        robots,
         launcher,
         args.out.clone(),
         Duration::from_millis(args.join_timeout_ms),
