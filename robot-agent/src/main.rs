@@ -155,17 +155,27 @@ const JOIN_RETRY: Duration = Duration::from_secs(10);
 /// Pause between two attempts to join.
 const JOIN_RETRY_PAUSE: Duration = Duration::from_millis(20);
 
-/// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports of the
-/// agent it replaces (iceoryx2 offers no notification of that), so a full service is retried for a while.
+/// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports and
+/// the node place of the agent it replaces (iceoryx2 offers no notification of that), so an exhausted limit is
+/// retried for a while.
 fn join(run: &RunSpec, robot: u32) -> Result<AgentLink> {
     let started = Instant::now();
     loop {
         match AgentLink::join(run, robot) {
-            Err(TransportError::ServiceFull { .. }) if started.elapsed() < JOIN_RETRY => {
+            Err(e) if limit_reached(&e) && started.elapsed() < JOIN_RETRY => {
                 std::thread::sleep(JOIN_RETRY_PAUSE);
             }
             other => return Ok(other?),
         }
+    }
+}
+
+/// Whether joining failed on an iceoryx2 limit that a dead agent may still hold.
+fn limit_reached(error: &TransportError) -> bool {
+    match error {
+        TransportError::ServiceFull { .. } => true,
+        TransportError::Iceoryx { detail, .. } => detail.contains("ExceedsMax"),
+        _ => false,
     }
 }
 

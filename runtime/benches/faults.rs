@@ -98,14 +98,14 @@ fn main() -> Result<()> {
         let robot = (i * 37 + 11) % robots.max(1);
         ctl(out.path(), &["kill", &robot.to_string()])?;
         let start = Instant::now();
-        let back = format!("restarts {}", 1);
+        let back = "restarts 1";
         loop {
             let list = ctl(out.path(), &["list"])?;
             let line = list
                 .lines()
                 .find(|l| l.starts_with(&format!("robot {robot} ")))
                 .unwrap_or_default();
-            if line.contains(" running ") && line.ends_with(&back) {
+            if line.contains(" running ") && line.ends_with(back) {
                 break;
             }
             if start.elapsed() > REJOIN_TIMEOUT {

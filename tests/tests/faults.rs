@@ -32,6 +32,10 @@ fn run_with_faults(out: &Path, ticks: u64, seed: u64, faults: &[&str]) -> SwarmO
         ticks.as_str(),
         "--seed",
         seed.as_str(),
+        // Scheduled faults never wait for a deadline; a generous one keeps a loaded machine from adding
+        // unscheduled deadline misses to the records.
+        "--tick-deadline-ms",
+        "10000",
     ];
     for fault in faults {
         args.extend(["--fault", fault]);

@@ -407,17 +407,23 @@ fn targets(ctx: &mut Ctx, el: &Element, random_allowed: bool) -> Option<Targets>
             ctx.error(el.location, format!("<{}> needs {what}", el.name), None);
             None
         }
+        [_] => {
+            ctx.error(
+                el.location,
+                format!(
+                    "<{}> needs 'robots': random targets ('fraction', 'count') are for <kill>",
+                    el.name
+                ),
+                None,
+            );
+            None
+        }
         _ => {
             ctx.error(
                 el.location,
                 format!(
-                    "<{}> takes one of {}, not {}",
+                    "<{}> takes one of 'robots', 'fraction' and 'count', not {}",
                     el.name,
-                    if random_allowed {
-                        "'robots', 'fraction', 'count'"
-                    } else {
-                        "'robots'"
-                    },
                     given.join(" and ")
                 ),
                 None,
@@ -697,7 +703,10 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(err.contains("<freeze> needs 'robots'"), "{err}");
+        assert!(
+            err.contains(":3:9: <freeze> needs 'robots': random targets"),
+            "{err}"
+        );
         assert!(
             err.contains("'sometimes' is not never, on-failure or always"),
             "{err}"

@@ -153,7 +153,7 @@ impl Drop for ControlServer {
 }
 
 /// Handles one connection: one request line, one answer.
-fn serve(stream: UnixStream, requests: &Sender<CtlRequest>) {
+fn serve(mut stream: UnixStream, requests: &Sender<CtlRequest>) {
     let _ = stream.set_read_timeout(Some(REPLY_TIMEOUT));
     let mut line = String::new();
     let Ok(reader) = stream.try_clone() else {
@@ -179,7 +179,6 @@ fn serve(stream: UnixStream, requests: &Sender<CtlRequest>) {
         Ok(text) => format!("ok\n{text}"),
         Err(reason) => format!("error\n{reason}\n"),
     };
-    let mut stream = stream;
     let _ = stream.write_all(text.as_bytes());
 }
 

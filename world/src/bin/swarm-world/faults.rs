@@ -105,16 +105,22 @@ pub fn follow_launcher(notices: DeathNotices) -> Receiver<WorldCommand> {
 }
 
 impl FaultDriver {
-    /// The driver of a run of `robots` robots with `schedule`, seeded with `seed`.
+    /// The driver of a run of `robots` robots with `schedule`, seeded with `seed`. Call it before any agent
+    /// can join: every robot starts without an agent in the transport (a death notice each), so a robot counts
+    /// as present only once its agent has connected, not merely claimed its slot.
     pub fn new(
+        link: &WorldLink,
         schedule: &FaultSchedule,
         ticks_per_second: u32,
         seed: u64,
-        robots: usize,
         commands: Receiver<WorldCommand>,
         out_dir: PathBuf,
         join_timeout: Duration,
-    ) -> FaultDriver {
+    ) -> anyhow::Result<FaultDriver> {
+        let robots = link.config().robots as usize;
+        for robot in 0..robots as u32 {
+            link.mark_dead(robot)?;
+        }
         let mut plan = FaultPlan::new(schedule, ticks_per_second, seed);
         let mut due = Vec::new();
         plan.due(0, &vec![true; robots], &mut due);
@@ -124,7 +130,7 @@ impl FaultDriver {
             .filter_map(|a| a.robot)
             .collect();
         due.clear();
-        FaultDriver {
+        Ok(FaultDriver {
             plan,
             robots: vec![Robot::Alive; robots],
             rejoin_at: vec![None; robots],
@@ -136,7 +142,7 @@ impl FaultDriver {
             alive_mask: vec![true; robots],
             out_dir,
             join_timeout,
-        }
+        })
     }
 
     /// Whether robot `robot` takes part in the coming tick.
@@ -367,11 +373,13 @@ impl FaultDriver {
         }
         .write(&self.out_dir)?;
         // Scheduled faults get their own row from the schedule.
-        match cause {
-            Down::Killed | Down::Frozen => Ok(()),
-            Down::Notice => Ok(events.record_fault(tick, robot as usize, "fault:down")?),
-            Down::Deadline => Ok(events.record_fault(tick, robot as usize, "fault:missed")?),
-        }
+        let name = match cause {
+            Down::Killed | Down::Frozen => return Ok(()),
+            Down::Notice => "fault:down",
+            Down::Deadline => "fault:missed",
+        };
+        events.record_fault(tick, robot as usize, name)?;
+        Ok(())
     }
 
     /// `robot` takes part again from `tick`.

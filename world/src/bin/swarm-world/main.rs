@@ -106,14 +106,14 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             let link = WorldLink::create(&run, link_config)?;
             let launcher = faults::follow_launcher(link.death_notices());
             let driver = FaultDriver::new(
+                &link,
                 &schedule,
                 experiment.framework.ticks_per_second,
                 args.seed,
-                robots,
                 launcher,
                 args.out.clone(),
                 Duration::from_millis(args.join_timeout_ms),
-            );
+            )?;
             (Link::Local(link), Some(driver))
         }
         Some(plan) => {
