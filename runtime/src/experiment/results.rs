@@ -167,6 +167,9 @@ pub fn metric_names(runs: &[RunResult]) -> Vec<String> {
     names.into_iter().cloned().collect()
 }
 
+/// Columns of `results.csv` between the factors and the metrics.
+const FIXED_COLUMNS: [&str; 6] = ["robots", "seed", "runs", "ticks", "wall_seconds", "deaths"];
+
 /// `results.csv`: one row per finished run (`kind` = `run`) and one per configuration (`kind` =
 /// `configuration`: the median run's values, the number of runs and each metric's mean, min and max).
 pub fn csv(
@@ -178,17 +181,25 @@ pub fn csv(
     let metrics = metric_names(runs);
     let mut header: Vec<String> = vec!["kind".into(), "configuration".into()];
     header.extend(grid.factors.iter().map(|f| f.name.clone()));
-    header.extend(
-        ["robots", "seed", "runs", "ticks", "wall_seconds", "deaths"]
-            .iter()
-            .map(|s| (*s).to_owned()),
-    );
-    header.extend(metrics.iter().cloned());
-    for m in &metrics {
+    header.extend(FIXED_COLUMNS.iter().map(|s| (*s).to_owned()));
+    // A metric named like another column (e.g. the loop functions' `ticks`) keeps its place as `metrics.<name>`.
+    let columns: Vec<String> = metrics
+        .iter()
+        .map(|m| {
+            if header.contains(m) {
+                format!("metrics.{m}")
+            } else {
+                m.clone()
+            }
+        })
+        .collect();
+    for column in &columns {
         for stat in ["mean", "min", "max"] {
-            header.push(format!("{m}_{stat}"));
+            header.push(format!("{column}_{stat}"));
         }
     }
+    let stats_at = header.len() - 3 * columns.len();
+    header.splice(stats_at..stats_at, columns);
     let mut out = String::new();
     push_row(&mut out, &header);
 
@@ -310,6 +321,36 @@ mod tests {
         assert_eq!(results[0].median_run, None);
         assert!(results[0].runs.is_empty());
         assert_eq!(results[1].median_run, Some(0));
+    }
+
+    #[test]
+    fn csv_has_a_row_per_run_and_per_configuration_and_renames_clashing_metrics() {
+        let grid = Grid::parse(
+            Path::new("g.toml"),
+            "base = \"b.argos\"\nrepetitions = 2\nmedian_metric = \"TO\"\n[[factor]]\nname = \"E\"\nset = [\"noise\"]\nvalues = [0]\n",
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let configurations = vec![Configuration {
+            id: "E-0".into(),
+            levels: vec![0],
+            robots: 4,
+            text: String::new(),
+        }];
+        let mut runs = vec![run(0, 1, 3.0), run(0, 2, 5.0)];
+        for r in &mut runs {
+            r.metrics.insert("ticks".into(), 100.0);
+        }
+        let results = select_medians(1, &runs, "TO");
+        let text = csv(&grid, &configurations, &runs, &results);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[0],
+            "kind,configuration,E,robots,seed,runs,ticks,wall_seconds,deaths,TO,metrics.ticks,yield,TO_mean,TO_min,\
+             TO_max,metrics.ticks_mean,metrics.ticks_min,metrics.ticks_max,yield_mean,yield_min,yield_max"
+        );
+        assert_eq!(lines[1], "run,E-0,0,4,1,,100,1.000,0,3,100,1,,,,,,,,,");
+        assert_eq!(lines[3], "configuration,E-0,0,4,1,2,100,1.000,0,3,100,1,4,3,5,100,100,100,1.5,1,2");
+        assert_eq!(lines.len(), 4);
     }
 
     #[test]
