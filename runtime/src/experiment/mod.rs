@@ -33,9 +33,11 @@ use plan::Configuration;
 use results::RunResult;
 use store::{BatchDir, RunState};
 
-/// Memory one run process (world or agent) is assumed to need when `--jobs` is left to the machine. Measured:
-/// an obstacle-avoidance agent peaks at about 10 MB resident, the world at about 40 MB; the figure leaves room.
-const MEMORY_PER_PROCESS: u64 = 24 << 20;
+/// Memory a run's world process is assumed to need when `--jobs` is left to the machine. Measured: the world of a
+/// 10-robot obstacle-avoidance run peaks at ~155 MB resident (debug build, shared memory included).
+const MEMORY_PER_WORLD: u64 = 192 << 20;
+/// Memory an agent process is assumed to need: measured ~10 MB resident; the figure leaves room.
+const MEMORY_PER_AGENT: u64 = 16 << 20;
 
 /// What `swarm experiment` was asked to do.
 #[derive(Debug, Clone, Default)]
@@ -100,10 +102,10 @@ fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> ExperimentError
 
 /// Runs at once when `--jobs` is not given: one per core (a lockstep run alternates a serial world phase with a
 /// parallel agent phase, so it rarely keeps every core busy alone, and a second run fills the gaps), but no more
-/// than available memory holds with `robots + 1` processes per run.
+/// than available memory holds with one world and `max_robots` agents per run.
 pub fn default_jobs(max_robots: u32) -> usize {
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let per_run = (u64::from(max_robots) + 1) * MEMORY_PER_PROCESS;
+    let per_run = MEMORY_PER_WORLD + u64::from(max_robots) * MEMORY_PER_AGENT;
     let by_memory = available_memory().map_or(cores, |bytes| (bytes / per_run.max(1)) as usize);
     cores.min(by_memory).max(1)
 }

@@ -34,8 +34,8 @@ const SIZE: (u32, u32) = (900, 560);
 pub struct Figure {
     /// The metric drawn.
     pub metric: String,
-    /// The factor drawn as lines.
-    pub line_factor: String,
+    /// The factor drawn as lines (`None`: one line).
+    pub line_factor: Option<String>,
     /// The fixed levels of the family, e.g. `No = 5, RE = true` (empty for a single family).
     pub family: String,
     /// The PNG, relative to the batch folder.

@@ -104,11 +104,14 @@ pub fn markdown(
         let heading = (&figure.metric, &figure.line_factor);
         if current != Some(heading) {
             current = Some(heading);
-            let _ = writeln!(
-                out,
-                "### `{}` by robot count, one line per `{}`\n",
-                figure.metric, figure.line_factor
-            );
+            let _ = match &figure.line_factor {
+                Some(line) => writeln!(
+                    out,
+                    "### `{}` by robot count, one line per `{line}`\n",
+                    figure.metric
+                ),
+                None => writeln!(out, "### `{}` by robot count\n", figure.metric),
+            };
         }
         let alt = if figure.family.is_empty() {
             figure.metric.clone()

@@ -349,7 +349,10 @@ mod tests {
              TO_max,metrics.ticks_mean,metrics.ticks_min,metrics.ticks_max,yield_mean,yield_min,yield_max"
         );
         assert_eq!(lines[1], "run,E-0,0,4,1,,100,1.000,0,3,100,1,,,,,,,,,");
-        assert_eq!(lines[3], "configuration,E-0,0,4,1,2,100,1.000,0,3,100,1,4,3,5,100,100,100,1.5,1,2");
+        assert_eq!(
+            lines[3],
+            "configuration,E-0,0,4,1,2,100,1.000,0,3,100,1,4,3,5,100,100,100,1.5,1,2"
+        );
         assert_eq!(lines.len(), 4);
     }
 
