@@ -310,6 +310,8 @@ fn run_one(
             Ok(_) => Outcome::Completed,
             Err(e) => Outcome::Failed(format!("completing {}: {e}", partial.display())),
         },
+        // A run stopped while it started up fails rather than reporting an interruption; it is not a failure.
+        Err(_) if stop.load(Ordering::Relaxed) => Outcome::Interrupted,
         Err(e) => Outcome::Failed(format!("{e} (its records are in {})", partial.display())),
     }
 }

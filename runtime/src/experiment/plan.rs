@@ -310,6 +310,24 @@ mod tests {
     }
 
     #[test]
+    fn shipped_grids_derive_valid_configurations() {
+        let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+        for (file, count, robots) in [
+            ("obstacle_avoidance/grid_small.toml", 2, vec![4, 8]),
+            ("foraging/grid_reduced.toml", 16, vec![10, 20]),
+            ("foraging/grid_thesis.toml", 480, vec![10, 20, 40, 70, 100]),
+        ] {
+            let grid = Grid::load(&configs.join(file)).unwrap_or_else(|e| panic!("{e}"));
+            let configurations = configurations(&grid).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(configurations.len(), count, "{file}");
+            let mut seen: Vec<u32> = configurations.iter().map(|c| c.robots).collect();
+            seen.sort_unstable();
+            seen.dedup();
+            assert_eq!(seen, robots, "{file}");
+        }
+    }
+
+    #[test]
     fn misspelt_attribute_is_an_error_not_a_silent_warning() {
         let grid = grid(
             "[[factor]]\nname = \"No\"\nset = [\"arena/distribute[entity/box]/entity@quantiy\"]\nvalues = [2]\n",
