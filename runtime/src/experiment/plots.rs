@@ -164,11 +164,10 @@ pub fn draw(
                         .collect::<Vec<_>>()
                         .join("_")
                 };
-                let line_name =
-                    line.map_or_else(|| "none".to_owned(), |f| grid.factors[f].name.clone());
+                let line_name = line.map(|f| grid.factors[f].name.clone());
                 let relative = Path::new("plots")
                     .join(file_safe(metric))
-                    .join(&line_name)
+                    .join(line_name.as_deref().unwrap_or("single"))
                     .join(format!("{file}.png"));
                 let series: Vec<(String, Vec<(f64, f64)>)> = lines
                     .into_iter()
