@@ -29,6 +29,11 @@ const FONT_CANDIDATES: &[&str] = &[
 /// Figure size in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
+/// The (robot count, metric value) points of one line.
+type Points = Vec<(f64, f64)>;
+/// A family's fixed levels -> the line factor's level -> the line's points.
+type Families = BTreeMap<Vec<usize>, BTreeMap<usize, Points>>;
+
 /// One written figure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
@@ -114,8 +119,7 @@ pub fn draw(
     for metric in metrics {
         for &line in &line_factors {
             // family levels -> line level -> (robots, value) points
-            let mut families: BTreeMap<Vec<usize>, BTreeMap<usize, Vec<(f64, f64)>>> =
-                BTreeMap::new();
+            let mut families: Families = BTreeMap::new();
             for result in results {
                 let Some(value) = result
                     .median_run
@@ -169,7 +173,7 @@ pub fn draw(
                     .join(file_safe(metric))
                     .join(line_name.as_deref().unwrap_or("single"))
                     .join(format!("{file}.png"));
-                let series: Vec<(String, Vec<(f64, f64)>)> = lines
+                let series: Vec<(String, Points)> = lines
                     .into_iter()
                     .map(|(level, mut points)| {
                         points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -220,7 +224,7 @@ fn draw_figure(
     path: &Path,
     title: &str,
     metric: &str,
-    series: &[(String, Vec<(f64, f64)>)],
+    series: &[(String, Points)],
 ) -> Result<(), PlotError> {
     let fail = |reason: String| PlotError::Draw {
         path: path.display().to_string(),
