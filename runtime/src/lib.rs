@@ -2,11 +2,13 @@
 //!
 //! It holds what a controller may see and do (the sensor frame and actuator command in [`messages`]), the local
 //! lockstep transport over iceoryx2 ([`transport`]) and the ptSCT [`player`], the experiment
-//! configuration ([`config`]) and the [`launcher`] behind `swarm`. It never depends on the world or on the robot
+//! configuration ([`config`]), the [`launcher`] behind `swarm run` and the grid runner behind `swarm
+//! experiment` ([`experiment`]). It never depends on the world or on the robot
 //! agent.
 
 pub mod bench;
 pub mod config;
+pub mod experiment;
 pub mod launcher;
 pub mod logging;
 pub mod messages;

@@ -434,5 +434,35 @@ impl Drop for Netns {
     fn drop(&mut self) {
         let _ = ip(&["link", "del", &self.outer]);
         let _ = ip(&["netns", "del", &self.name]);
+}
+/// Kills every process still running for runs starting with `run_prefix` and removes their shared-memory files
+/// and iceoryx2 root folders: the cleanup after a test killed a launcher on purpose (SIGKILL leaves them behind).
+pub fn wipe_runs(run_prefix: &str) {
+    for pid in process_leftovers(run_prefix) {
+        if let Ok(pid) = i32::try_from(pid) {
+            let _ = nix::sys::signal::kill(
+                nix::unistd::Pid::from_raw(pid),
+                nix::sys::signal::Signal::SIGKILL,
+            );
+        }
+    }
+    let roots = std::fs::read_dir(std::env::temp_dir())
+        .map(|entries| entries.flatten().map(|e| e.path()).collect::<Vec<_>>())
+        .unwrap_or_default();
+    for root in roots {
+        let Some(name) = root
+            .file_name()
+            .and_then(|n| n.to_str())
+            .and_then(|n| n.strip_prefix("iceoryx2-"))
+            .filter(|n| n.starts_with(run_prefix))
+        else {
+            continue;
+        };
+        if let Ok(spec) = swarm_runtime::transport::RunSpec::new(name, &root) {
+            let _ = spec.cleanup();
+        }
+    }
+    for file in shm_leftovers(run_prefix) {
+        let _ = std::fs::remove_file(file);
     }
 }

@@ -8,6 +8,9 @@
 //!
 //! `swarm host --connect <endpoint>` runs one machine's share of multi-host runs (docs/hosts.md); `swarm run
 //! --hosts a,b` places a run's robots on such hosts.
+//!
+//! `swarm experiment <grid.toml>` runs a grid of configurations x seeds into a batch folder (`docs/experiments.md`):
+//! several runs at once, resumable, with `results.csv`, figures and `report.md`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,6 +21,8 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 use swarm_runtime::bench::BenchOptions;
+use swarm_runtime::experiment::{self, ExperimentOptions};
+use swarm_runtime::launcher::binaries::Binaries;
 use swarm_runtime::launcher::control::{self, CtlCommand};
 use swarm_runtime::launcher::hosts::HostsArgs;
 use swarm_runtime::launcher::{self, RunOptions};
@@ -82,6 +87,20 @@ enum Commands {
     /// Run this machine's share of multi-host runs: announce this host, start the robots the world assigns it,
     /// and bridge their frames and commands over zenoh.
     Host(HostCli),
+    /// Run a grid of configurations x seeds (a TOML grid file); a rerun continues where a stopped one ended.
+    Experiment {
+        /// The grid file (.toml).
+        grid: PathBuf,
+        /// Batch folder (overrides the grid's `out`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Runs at once (default: one per core, fewer if memory is short).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not draw a progress bar.
+        #[arg(long)]
+        no_progress: bool,
+    },
 }
 
 /// What `swarm ctl` asks a live run.
@@ -216,6 +235,17 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Commands::Bench(args) => bench(args),
+        Commands::Experiment {
+            grid,
+            out,
+            jobs,
+            no_progress,
+        } => run_experiment(ExperimentOptions {
+            grid,
+            out,
+            jobs,
+            progress: !no_progress,
+        }),
         Commands::Run {
             config,
             robots,
@@ -338,4 +368,51 @@ fn run_host(cli: HostCli) -> anyhow::Result<()> {
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
     host::serve(&options, &stop).with_context(|| format!("host '{}'", options.name))
+}
+
+/// `swarm experiment`: runs the batch, prints where its results are, and fails if any run failed.
+fn run_experiment(options: ExperimentOptions) -> anyhow::Result<()> {
+    // Find (under cargo: build) the world and agent programs once, rather than once per run from parallel threads.
+    let binaries = Binaries::locate().context("locating the world and agent programs")?;
+    if std::env::var_os("SWARM_BIN_DIR").is_none()
+        && let Some(dir) = binaries.world.parent()
+    {
+        // SAFETY: the process has one thread here; the Ctrl-C handler's thread and the runs start below.
+        unsafe { std::env::set_var("SWARM_BIN_DIR", dir) };
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    let report = experiment::run(&options, stop)
+        .with_context(|| format!("running the grid {}", options.grid.display()))?;
+    println!(
+        "{}: {} configurations, {} of {} runs finished ({} by earlier invocations), {} failed, {} at once; results \
+         in {}",
+        if report.interrupted {
+            "stopped"
+        } else {
+            "done"
+        },
+        report.configurations,
+        report.runs_reused + report.runs_completed,
+        report.runs_planned,
+        report.runs_reused,
+        report.failures.len(),
+        report.jobs,
+        report.dir.join("results.csv").display()
+    );
+    if let Some(reason) = &report.plots_missing {
+        eprintln!("warning: no figures: {reason}");
+    }
+    if report.interrupted {
+        println!("run the same command again to continue");
+    }
+    anyhow::ensure!(
+        report.failures.is_empty(),
+        "{} run(s) failed:\n{}",
+        report.failures.len(),
+        report.failures.join("\n")
+    );
+    Ok(())
 }

@@ -1,0 +1,279 @@
+//! PNG figures of a batch, as the thesis draws them: each metric against the robot count, one figure per
+//! configuration family (the configurations that share every factor level except the robot factor and the line
+//! factor), one line per level of the line factor, each point the configuration's median run.
+//!
+//! Text is drawn with a TrueType font read once at run time (`SWARM_PLOT_FONT`, else a common system font), so
+//! the build needs no font library; without a font the batch still writes its table and report and says why the
+//! figures are missing.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use plotters::prelude::*;
+
+use super::grid::Grid;
+use super::plan::{Configuration, file_safe};
+use super::results::{ConfigResult, RunResult};
+
+/// The font family name the figures use.
+const FAMILY: &str = "sans-serif";
+/// Fonts tried in order when `SWARM_PLOT_FONT` is not set.
+const FONT_CANDIDATES: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation2/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+];
+/// Figure size in pixels.
+const SIZE: (u32, u32) = (900, 560);
+
+/// The (robot count, metric value) points of one line.
+type Points = Vec<(f64, f64)>;
+/// A family's fixed levels -> the line factor's level -> the line's points.
+type Families = BTreeMap<Vec<usize>, BTreeMap<usize, Points>>;
+
+/// One written figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// The metric drawn.
+    pub metric: String,
+    /// The factor drawn as lines (`None`: one line).
+    pub line_factor: Option<String>,
+    /// The fixed levels of the family, e.g. `No = 5, RE = true` (empty for a single family).
+    pub family: String,
+    /// The PNG, relative to the batch folder.
+    pub path: PathBuf,
+}
+
+/// Why figures could not be drawn.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PlotError {
+    /// No usable font.
+    #[error(
+        "no font to draw figures with: set SWARM_PLOT_FONT to a .ttf file or install one (e.g. Debian's \
+         fonts-dejavu-core); tried {tried}"
+    )]
+    NoFont {
+        /// The files tried.
+        tried: String,
+    },
+    /// Drawing or writing a figure failed.
+    #[error("{path}: {reason}")]
+    Draw {
+        /// The figure.
+        path: String,
+        /// What failed.
+        reason: String,
+    },
+}
+
+/// Registers the figures' font once per process.
+fn font() -> Result<(), PlotError> {
+    static FONT: OnceLock<Result<(), PlotError>> = OnceLock::new();
+    FONT.get_or_init(|| {
+        let candidates: Vec<PathBuf> = std::env::var_os("SWARM_PLOT_FONT")
+            .map(PathBuf::from)
+            .into_iter()
+            .chain(FONT_CANDIDATES.iter().map(PathBuf::from))
+            .collect();
+        for path in &candidates {
+            let Ok(bytes) = std::fs::read(path) else {
+                continue;
+            };
+            // The font must live as long as the process: plotters keeps a reference in its registry.
+            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            if plotters::style::register_font(FAMILY, FontStyle::Normal, bytes).is_ok() {
+                tracing::debug!(font = %path.display(), "figures use this font");
+                return Ok(());
+            }
+        }
+        Err(PlotError::NoFont {
+            tried: candidates
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+    })
+    .clone()
+}
+
+/// Draws every figure of the batch under `<batch>/plots/`; returns them in drawing order.
+pub fn draw(
+    batch: &Path,
+    grid: &Grid,
+    configurations: &[Configuration],
+    runs: &[RunResult],
+    results: &[ConfigResult],
+    metrics: &[String],
+) -> Result<Vec<Figure>, PlotError> {
+    font()?;
+    let mut figures = Vec::new();
+    let line_factors: Vec<Option<usize>> = if grid.line_factors.is_empty() {
+        vec![None]
+    } else {
+        grid.line_factors.iter().copied().map(Some).collect()
+    };
+    for metric in metrics {
+        for &line in &line_factors {
+            // family levels -> line level -> (robots, value) points
+            let mut families: Families = BTreeMap::new();
+            for result in results {
+                let Some(value) = result
+                    .median_run
+                    .and_then(|i| runs[i].metrics.get(metric).copied())
+                else {
+                    continue;
+                };
+                let c = &configurations[result.configuration];
+                let family: Vec<usize> = (0..grid.factors.len())
+                    .filter(|&f| Some(f) != grid.x_factor && Some(f) != line)
+                    .map(|f| c.levels[f])
+                    .collect();
+                let line_level = line.map_or(0, |f| c.levels[f]);
+                families
+                    .entry(family)
+                    .or_default()
+                    .entry(line_level)
+                    .or_default()
+                    .push((f64::from(c.robots), value));
+            }
+            let family_factors: Vec<usize> = (0..grid.factors.len())
+                .filter(|&f| Some(f) != grid.x_factor && Some(f) != line)
+                .collect();
+            for (family, lines) in families {
+                let named: Vec<(String, String)> = family_factors
+                    .iter()
+                    .zip(&family)
+                    .map(|(&f, &l)| {
+                        (
+                            grid.factors[f].name.clone(),
+                            grid.factors[f].levels[l].label.clone(),
+                        )
+                    })
+                    .collect();
+                let family_text = named
+                    .iter()
+                    .map(|(n, l)| format!("{n} = {l}"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let file = if named.is_empty() {
+                    "all".to_owned()
+                } else {
+                    named
+                        .iter()
+                        .map(|(n, l)| format!("{n}-{}", file_safe(l)))
+                        .collect::<Vec<_>>()
+                        .join("_")
+                };
+                let line_name = line.map(|f| grid.factors[f].name.clone());
+                let relative = Path::new("plots")
+                    .join(file_safe(metric))
+                    .join(line_name.as_deref().unwrap_or("single"))
+                    .join(format!("{file}.png"));
+                let series: Vec<(String, Points)> = lines
+                    .into_iter()
+                    .map(|(level, mut points)| {
+                        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        let label = match line {
+                            Some(f) => format!(
+                                "{} = {}",
+                                grid.factors[f].name, grid.factors[f].levels[level].label
+                            ),
+                            None => metric.clone(),
+                        };
+                        (label, points)
+                    })
+                    .collect();
+                let title = if family_text.is_empty() {
+                    format!("{metric} (median runs)")
+                } else {
+                    format!("{metric} (median runs), {family_text}")
+                };
+                draw_figure(&batch.join(&relative), &title, metric, &series)?;
+                figures.push(Figure {
+                    metric: metric.clone(),
+                    line_factor: line_name,
+                    family: family_text,
+                    path: relative,
+                });
+            }
+        }
+    }
+    Ok(figures)
+}
+
+/// A range around `values` with a margin, never empty.
+fn padded(values: impl Iterator<Item = f64> + Clone) -> std::ops::Range<f64> {
+    let min = values.clone().fold(f64::INFINITY, f64::min);
+    let max = values.fold(f64::NEG_INFINITY, f64::max);
+    if !min.is_finite() || !max.is_finite() {
+        return 0.0..1.0;
+    }
+    let span = if max > min {
+        max - min
+    } else {
+        min.abs().max(1.0)
+    };
+    (min - 0.08 * span)..(max + 0.08 * span)
+}
+
+fn draw_figure(
+    path: &Path,
+    title: &str,
+    metric: &str,
+    series: &[(String, Points)],
+) -> Result<(), PlotError> {
+    let fail = |reason: String| PlotError::Draw {
+        path: path.display().to_string(),
+        reason,
+    };
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|e| fail(e.to_string()))?;
+    }
+    let points = series.iter().flat_map(|(_, p)| p.iter());
+    let x_range = padded(points.clone().map(|p| p.0));
+    let y_range = padded(points.map(|p| p.1));
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FAMILY, 20))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(|e| fail(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .x_desc("robots")
+        .y_desc(metric)
+        .label_style((FAMILY, 14))
+        .draw()
+        .map_err(|e| fail(e.to_string()))?;
+    for (i, (label, points)) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                color.stroke_width(2),
+            ))
+            .map_err(|e| fail(e.to_string()))?
+            .label(label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(|e| fail(e.to_string()))?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FAMILY, 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| fail(e.to_string()))?;
+    root.present().map_err(|e| fail(e.to_string()))
+}
