@@ -22,8 +22,9 @@ use crate::loop_functions::{LoopFunctions, LoopFunctionsParams, params::ParamRea
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "aggregation_loop_functions";
-/// Default largest body-to-body gap between neighbours of a cluster: one robot diameter (tasks.md 1).
-pub const DEFAULT_GAP: f32 = 2.0 * ROBOT_RADIUS;
+/// Default largest body-to-body gap between neighbours of a cluster in metres: one robot diameter, 2 x
+/// [`ROBOT_RADIUS`] (tasks.md 1).
+pub const DEFAULT_GAP: f64 = 0.07;
 /// Default time between two samples of the series, in seconds.
 pub const DEFAULT_SAMPLE_INTERVAL: f32 = 5.0;
 /// Default fraction of the robots the largest cluster must exceed (tasks.md 1: 0.9).
@@ -140,7 +141,7 @@ pub fn count_clusters(
 /// Clusters over time.
 #[derive(Debug, Clone)]
 pub struct Aggregation {
-    gap: f32,
+    gap: f64,
     sample_interval_s: f32,
     fraction: f64,
     scratch: ClusterScratch,
@@ -151,7 +152,7 @@ pub struct Aggregation {
 
 impl Aggregation {
     /// Loop functions with the given largest gap (m), sample interval (s) and largest-cluster fraction.
-    pub fn new(gap: f32, sample_interval_s: f32, fraction: f64) -> Self {
+    pub fn new(gap: f64, sample_interval_s: f32, fraction: f64) -> Self {
         Self {
             gap,
             sample_interval_s,
@@ -170,7 +171,7 @@ impl Aggregation {
             "aggregation",
             &["gap", "sample_interval", "fraction"],
         )?;
-        let gap = reader.non_negative("gap", f64::from(DEFAULT_GAP))? as f32;
+        let gap = reader.non_negative("gap", DEFAULT_GAP)?;
         let interval =
             reader.positive("sample_interval", f64::from(DEFAULT_SAMPLE_INTERVAL))? as f32;
         let fraction = reader.unit("fraction", DEFAULT_FRACTION)?;
@@ -193,7 +194,7 @@ impl Aggregation {
 
     fn record(&mut self, arena: &Arena) {
         let robots = arena.robots.iter().filter(|r| r.alive).map(|r| r.position);
-        self.latest = count_clusters(robots, self.gap, &mut self.scratch);
+        self.latest = count_clusters(robots, self.gap as f32, &mut self.scratch);
         let ClusterCount {
             clusters,
             largest,
@@ -261,7 +262,7 @@ mod tests {
     fn count(points: &[(f32, f32)]) -> ClusterCount {
         count_clusters(
             points.iter().map(|&(x, y)| Vec2::new(x, y)),
-            DEFAULT_GAP,
+            DEFAULT_GAP as f32,
             &mut ClusterScratch::default(),
         )
     }
@@ -278,6 +279,11 @@ mod tests {
                 robots: 3
             }
         );
+    }
+
+    #[test]
+    fn default_gap_is_one_robot_diameter() {
+        assert!((DEFAULT_GAP - 2.0 * f64::from(ROBOT_RADIUS)).abs() < 1e-6);
     }
 
     #[test]

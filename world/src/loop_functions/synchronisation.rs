@@ -9,9 +9,12 @@
 //!   at tick t; the Kuramoto order parameter R = |mean(exp(2 pi i phase))| is 1 when all flash together, near 0
 //!   when phases are spread evenly; the spread is the circular standard deviation sqrt(-2 ln R) turned into ticks
 //!   with the mean period (0 when synchronised, null when R = 0).
+//! - **Time to order**: the first tick at which R reaches `order` (default 0.9) with every live robot having a
+//!   phase; a gentler synchrony measure than the window fraction, which a wave of flashes crossing the grid a
+//!   few ticks per robot never brings to 1.
 //!
 //! Configuration: `<loop_functions label="synchronisation_loop_functions"><synchronisation window="5"
-//! sample_interval="5"/></loop_functions>` (optional). tasks.md gives no stop condition. A tick allocates nothing
+//! sample_interval="5" order="0.9"/></loop_functions>` (optional). tasks.md gives no stop condition. A tick allocates nothing
 //! once the per-robot record exists (made on the first tick); the series is reserved.
 
 use std::f64::consts::TAU;
@@ -30,6 +33,8 @@ pub const LABEL: &str = "synchronisation_loop_functions";
 pub const DEFAULT_WINDOW: u64 = 5;
 /// Default time between two samples of the series, in seconds.
 pub const DEFAULT_SAMPLE_INTERVAL: f64 = 5.0;
+/// Default order parameter R that counts as phase-synchronised.
+pub const DEFAULT_ORDER: f64 = 0.9;
 /// Samples the series holds before it would have to grow (one hour at the default interval).
 const RESERVED_SAMPLES: usize = 720;
 
@@ -117,33 +122,44 @@ pub struct Sample {
 pub struct Synchronisation {
     window: u64,
     sample_interval_s: f64,
+    order: f64,
     robots: Vec<Flashes>,
     flashes: u64,
     best_since_sample: f64,
     synchrony_at: Option<u64>,
+    order_at: Option<u64>,
     series: Vec<Sample>,
 }
 
 impl Synchronisation {
-    /// Loop functions with a synchrony window of `window` ticks and a sample every `sample_interval_s` seconds.
-    pub fn new(window: u64, sample_interval_s: f64) -> Self {
+    /// Loop functions with a synchrony window of `window` ticks, a sample every `sample_interval_s` seconds, and
+    /// `order` as the order parameter that counts as synchronised.
+    pub fn new(window: u64, sample_interval_s: f64, order: f64) -> Self {
         Self {
             window,
             sample_interval_s,
+            order,
             robots: Vec::new(),
             flashes: 0,
             best_since_sample: 0.0,
             synchrony_at: None,
+            order_at: None,
             series: Vec::with_capacity(RESERVED_SAMPLES),
         }
     }
 
-    /// The factory registered under [`LABEL`]: reads the optional `<synchronisation window sample_interval>`.
+    /// The factory registered under [`LABEL`]: reads the optional `<synchronisation window sample_interval
+    /// order>`.
     pub fn factory(params: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
-        let reader = ParamReader::new(params, "synchronisation", &["window", "sample_interval"])?;
+        let reader = ParamReader::new(
+            params,
+            "synchronisation",
+            &["window", "sample_interval", "order"],
+        )?;
         Ok(Box::new(Self::new(
             reader.u64_at_least("window", DEFAULT_WINDOW, 1)?,
             reader.positive("sample_interval", DEFAULT_SAMPLE_INTERVAL)?,
+            reader.unit("order", DEFAULT_ORDER)?,
         )))
     }
 
@@ -192,6 +208,13 @@ impl LoopFunctions for Synchronisation {
             if in_window == alive && self.synchrony_at.is_none() {
                 self.synchrony_at = Some(tick);
             }
+            if self.order_at.is_none()
+                && let Some(phase) = self.phase_at(arena)
+                && phase.robots == alive
+                && phase.order_parameter >= self.order
+            {
+                self.order_at = Some(tick);
+            }
         }
         let every =
             ((self.sample_interval_s * f64::from(arena.ticks_per_second)).round() as u64).max(1);
@@ -215,6 +238,9 @@ impl LoopFunctions for Synchronisation {
             "flashes": self.flashes,
             "time_to_synchrony_tick": self.synchrony_at,
             "time_to_synchrony_s": self.synchrony_at.map(|t| t as f64 / tps),
+            "order_threshold": self.order,
+            "time_to_order_tick": self.order_at,
+            "time_to_order_s": self.order_at.map(|t| t as f64 / tps),
             "final_window_fraction": self.series.last().map(|s| s.window_fraction),
             "final_order_parameter": phase.map(|p| p.order_parameter),
             "final_phase_spread_ticks": phase.and_then(|p| p.spread_ticks),
@@ -257,7 +283,11 @@ mod tests {
 
     #[test]
     fn flashes_starting_4_ticks_apart_are_synchronous_with_w_5() {
-        let world = run(&[&[10], &[12], &[14]], 30, Synchronisation::new(5, 1.0));
+        let world = run(
+            &[&[10], &[12], &[14]],
+            30,
+            Synchronisation::new(5, 1.0, 0.9),
+        );
         let m = world.metrics();
         assert_eq!(m["flashes"], 3);
         assert_eq!(m["time_to_synchrony_tick"], 14);
@@ -266,7 +296,7 @@ mod tests {
 
     #[test]
     fn flashes_starting_5_ticks_apart_are_not_synchronous_with_w_5() {
-        let world = run(&[&[10], &[15]], 40, Synchronisation::new(5, 1.0));
+        let world = run(&[&[10], &[15]], 40, Synchronisation::new(5, 1.0, 0.9));
         let m = world.metrics();
         assert!(m["time_to_synchrony_tick"].is_null());
         assert_eq!(m["final_window_fraction"], 0.0);
@@ -277,7 +307,7 @@ mod tests {
 
     #[test]
     fn a_long_flash_starts_once() {
-        let world = run(&[&[10, 12]], 30, Synchronisation::new(5, 1.0));
+        let world = run(&[&[10, 12]], 30, Synchronisation::new(5, 1.0, 0.9));
         assert_eq!(world.metrics()["flashes"], 1);
     }
 
@@ -307,18 +337,37 @@ mod tests {
     #[test]
     fn robots_that_flashed_once_have_no_phase() {
         assert_eq!(phase_spread([], 10), None);
-        let world = run(&[&[3], &[4]], 20, Synchronisation::new(5, 1.0));
+        let world = run(&[&[3], &[4]], 20, Synchronisation::new(5, 1.0, 0.9));
         assert!(world.metrics()["final_order_parameter"].is_null());
     }
 
     #[test]
     fn periodic_flashing_one_tick_apart_reports_order_near_1() {
         // Period 40, phases 15/40 and 14/40 at tick 60: R = cos(pi / 40) = 0.99692.
-        let world = run(&[&[5, 45], &[6, 46]], 60, Synchronisation::new(5, 1.0));
+        let world = run(&[&[5, 45], &[6, 46]], 60, Synchronisation::new(5, 1.0, 0.9));
         let m = world.metrics();
         assert_eq!(m["time_to_synchrony_tick"], 6);
         let r = m["final_order_parameter"].as_f64().unwrap();
         assert!((r - 0.996_917).abs() < 1e-5, "{r}");
+    }
+
+    #[test]
+    fn order_reached_when_every_robot_has_a_phase_near_the_others() {
+        // At tick 46 both robots have a phase: R = cos(pi / 40) = 0.997 >= 0.9. Before it robot 1 has none.
+        let world = run(&[&[5, 45], &[6, 46]], 60, Synchronisation::new(5, 1.0, 0.9));
+        let m = world.metrics();
+        assert_eq!(m["time_to_order_tick"], 46);
+        assert_eq!(m["time_to_order_s"], 2.3);
+    }
+
+    #[test]
+    fn order_not_reached_with_opposite_phases() {
+        let world = run(
+            &[&[5, 45], &[25, 65]],
+            80,
+            Synchronisation::new(5, 1.0, 0.9),
+        );
+        assert!(world.metrics()["time_to_order_tick"].is_null());
     }
 
     #[test]
