@@ -23,7 +23,7 @@ def series(run_dir: Path) -> list:
 
 def aggregation(runs: Path) -> None:
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
-    for name in sorted(p.name for p in runs.glob("agg-s*")):
+    for name in sorted(p.name for p in runs.glob("agg-s*") if p.is_dir()):
         s = series(runs / name)
         t = [x["time_s"] for x in s]
         ax1.plot(t, [x["clusters"] for x in s], label=f"seed {name[5:]}")
