@@ -339,7 +339,8 @@ mod tests {
         let err = plan("x", &params, Path::new("/c")).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "unknown profile `flocking` in <params> (known profiles: obstacle_avoidance, obstacle_avoidance_sct)"
+            "unknown profile `flocking` in <params> (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
+             aggregation, synchronisation, synchronisation_sct)"
         );
     }
 

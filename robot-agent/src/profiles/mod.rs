@@ -2,7 +2,9 @@
 //!
 //! [`bind_profile`] builds one robot's memory from its parameters and binds it to a supervisor set's events.
 
+pub mod aggregation;
 pub mod obstacle_avoidance;
+pub mod synchronisation;
 pub mod timer;
 
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
@@ -14,7 +16,9 @@ use crate::binding::{BindError, bind};
 use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
+use aggregation::Aggregation;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
+use synchronisation::{Synchronisation, SynchronisationSct};
 
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
 pub struct BoxedCallbacks(Box<dyn EventCallbacks + Send>);
@@ -38,6 +42,9 @@ const PROFILES: &[(&str, BindFn)] = &[
         ObstacleAvoidanceSct::NAME,
         bind_boxed::<ObstacleAvoidanceSct>,
     ),
+    (Aggregation::NAME, bind_boxed::<Aggregation>),
+    (Synchronisation::NAME, bind_boxed::<Synchronisation>),
+    (SynchronisationSct::NAME, bind_boxed::<SynchronisationSct>),
 ];
 
 /// Why a profile could not be set up.
@@ -121,7 +128,8 @@ mod tests {
             .unwrap();
         assert_eq!(
             err.to_string(),
-            "unknown profile `foraging` (known profiles: obstacle_avoidance, obstacle_avoidance_sct)"
+            "unknown profile `foraging` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
+             aggregation, synchronisation, synchronisation_sct)"
         );
     }
 

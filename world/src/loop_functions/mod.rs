@@ -2,8 +2,11 @@
 //! `IsExperimentFinished`) plus the task metrics, registered under the label the configuration's
 //! `<loop_functions label="...">` uses. Tasks add their own by registering a factory; the core never changes.
 
+pub mod aggregation;
 pub mod default;
 pub mod obstacle_avoidance;
+pub mod params;
+pub mod synchronisation;
 
 use std::collections::BTreeMap;
 
@@ -65,7 +68,8 @@ pub struct LoopFunctionsRegistry {
 }
 
 impl Default for LoopFunctionsRegistry {
-    /// The built-in loop functions: `obstacle_avoidance_loop_functions`.
+    /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
+    /// `synchronisation_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -73,6 +77,11 @@ impl Default for LoopFunctionsRegistry {
         registry.register(
             obstacle_avoidance::LABEL,
             obstacle_avoidance::ObstacleAvoidance::factory,
+        );
+        registry.register(aggregation::LABEL, aggregation::Aggregation::factory);
+        registry.register(
+            synchronisation::LABEL,
+            synchronisation::Synchronisation::factory,
         );
         registry
     }

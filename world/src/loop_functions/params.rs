@@ -1,0 +1,151 @@
+//! Reading a task's settings from its `<loop_functions>` child element (e.g. `<aggregation gap="0.07"/>`), with
+//! errors that name the element's place in the configuration, the attribute and the rule it breaks.
+//!
+//! Only construction-time code uses this; it never runs per tick.
+
+use crate::error::WorldError;
+use crate::loop_functions::LoopFunctionsParams;
+
+/// The attributes of one child element of `<loop_functions>`, checked against the names a task knows.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamReader<'a> {
+    params: &'a LoopFunctionsParams,
+    element: &'static str,
+}
+
+impl<'a> ParamReader<'a> {
+    /// A reader of `<element ...>` inside `params`; any attribute of it not in `known` is an error.
+    pub fn new(
+        params: &'a LoopFunctionsParams,
+        element: &'static str,
+        known: &[&str],
+    ) -> Result<Self, WorldError> {
+        let prefix = format!("{element}.");
+        for key in params.attributes.keys() {
+            if let Some(name) = key.strip_prefix(&prefix)
+                && !known.contains(&name)
+            {
+                return Err(WorldError::Invalid {
+                    location: params.location.clone(),
+                    message: format!(
+                        "<{element}> has no attribute '{name}' (known: {})",
+                        known.join(", ")
+                    ),
+                });
+            }
+        }
+        Ok(Self { params, element })
+    }
+
+    /// Attribute `name` as a number >= 0, or `default` when absent.
+    pub fn non_negative(&self, name: &str, default: f64) -> Result<f64, WorldError> {
+        self.number(name, default, |v| v >= 0.0, "a number >= 0")
+    }
+
+    /// Attribute `name` as a number > 0, or `default` when absent.
+    pub fn positive(&self, name: &str, default: f64) -> Result<f64, WorldError> {
+        self.number(name, default, |v| v > 0.0, "a number > 0")
+    }
+
+    /// Attribute `name` as a number in [0, 1], or `default` when absent.
+    pub fn unit(&self, name: &str, default: f64) -> Result<f64, WorldError> {
+        self.number(
+            name,
+            default,
+            |v| (0.0..=1.0).contains(&v),
+            "a number in [0, 1]",
+        )
+    }
+
+    fn number(
+        &self,
+        name: &str,
+        default: f64,
+        ok: fn(f64) -> bool,
+        expected: &str,
+    ) -> Result<f64, WorldError> {
+        let Some(raw) = self
+            .params
+            .attributes
+            .get(&format!("{}.{name}", self.element))
+        else {
+            return Ok(default);
+        };
+        match raw.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && ok(v) => Ok(v),
+            _ => Err(self.invalid(name, raw, expected)),
+        }
+    }
+
+    /// Attribute `name` as a whole number >= `min`, or `default` when absent.
+    pub fn u64_at_least(&self, name: &str, default: u64, min: u64) -> Result<u64, WorldError> {
+        let Some(raw) = self
+            .params
+            .attributes
+            .get(&format!("{}.{name}", self.element))
+        else {
+            return Ok(default);
+        };
+        match raw.trim().parse::<u64>() {
+            Ok(v) if v >= min => Ok(v),
+            _ => Err(self.invalid(name, raw, &format!("a whole number >= {min}"))),
+        }
+    }
+
+    fn invalid(&self, name: &str, raw: &str, expected: &str) -> WorldError {
+        WorldError::Invalid {
+            location: self.params.location.clone(),
+            message: format!("<{} {name}=\"{raw}\">: must be {expected}", self.element),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params(attrs: &[(&str, &str)]) -> LoopFunctionsParams {
+        LoopFunctionsParams {
+            label: "x".to_owned(),
+            location: "e.argos:3:5".to_owned(),
+            attributes: attrs
+                .iter()
+                .map(|&(k, v)| (k.to_owned(), v.to_owned()))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn absent_attribute_takes_the_default() {
+        let p = params(&[]);
+        let r = ParamReader::new(&p, "task", &["a"]).unwrap();
+        assert_eq!(r.unit("a", 0.5).unwrap(), 0.5);
+        assert_eq!(r.u64_at_least("a", 7, 1).unwrap(), 7);
+    }
+
+    #[test]
+    fn attributes_of_other_elements_are_not_checked() {
+        let p = params(&[("other.b", "1")]);
+        assert!(ParamReader::new(&p, "task", &["a"]).is_ok());
+    }
+
+    #[test]
+    fn whole_number_below_the_minimum_is_rejected() {
+        let p = params(&[("task.window", "0")]);
+        let r = ParamReader::new(&p, "task", &["window"]).unwrap();
+        assert_eq!(
+            r.u64_at_least("window", 5, 1).unwrap_err().to_string(),
+            "e.argos:3:5: <task window=\"0\">: must be a whole number >= 1"
+        );
+    }
+
+    #[test]
+    fn zero_is_not_positive() {
+        let p = params(&[("task.every", "0")]);
+        let r = ParamReader::new(&p, "task", &["every"]).unwrap();
+        assert_eq!(
+            r.positive("every", 1.0).unwrap_err().to_string(),
+            "e.argos:3:5: <task every=\"0\">: must be a number > 0"
+        );
+    }
+}
