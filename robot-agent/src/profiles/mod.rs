@@ -2,7 +2,9 @@
 //!
 //! [`bind_profile`] builds one robot's memory from its parameters and binds it to a supervisor set's events.
 
+pub mod foraging;
 pub mod obstacle_avoidance;
+pub mod pheromone_foraging;
 pub mod timer;
 
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
@@ -14,7 +16,9 @@ use crate::binding::{BindError, bind};
 use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
+use foraging::Forager;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
+use pheromone_foraging::PheromoneForager;
 
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
 pub struct BoxedCallbacks(Box<dyn EventCallbacks + Send>);
@@ -38,6 +42,8 @@ const PROFILES: &[(&str, BindFn)] = &[
         ObstacleAvoidanceSct::NAME,
         bind_boxed::<ObstacleAvoidanceSct>,
     ),
+    (Forager::NAME, bind_boxed::<Forager>),
+    (PheromoneForager::NAME, bind_boxed::<PheromoneForager>),
 ];
 
 /// Why a profile could not be set up.
@@ -116,12 +122,12 @@ mod tests {
 
     #[test]
     fn unknown_profile_lists_the_known_ones() {
-        let err = bind_profile("foraging", &Params::default(), &[])
+        let err = bind_profile("flocking", &Params::default(), &[])
             .err()
             .unwrap();
         assert_eq!(
             err.to_string(),
-            "unknown profile `foraging` (known profiles: obstacle_avoidance, obstacle_avoidance_sct)"
+            "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, foraging, pheromone_foraging)"
         );
     }
 
