@@ -3,7 +3,9 @@
 //! `<loop_functions label="...">` uses. Tasks add their own by registering a factory; the core never changes.
 
 pub mod default;
+pub mod foraging;
 pub mod obstacle_avoidance;
+pub mod pheromone_foraging;
 
 use std::collections::BTreeMap;
 
@@ -65,7 +67,8 @@ pub struct LoopFunctionsRegistry {
 }
 
 impl Default for LoopFunctionsRegistry {
-    /// The built-in loop functions: `obstacle_avoidance_loop_functions`.
+    /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `foraging_loop_functions`,
+    /// `pheromone_foraging_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -73,6 +76,11 @@ impl Default for LoopFunctionsRegistry {
         registry.register(
             obstacle_avoidance::LABEL,
             obstacle_avoidance::ObstacleAvoidance::factory,
+        );
+        registry.register(foraging::LABEL, foraging::Foraging::factory);
+        registry.register(
+            pheromone_foraging::LABEL,
+            pheromone_foraging::PheromoneForaging::factory,
         );
         registry
     }
