@@ -157,7 +157,10 @@ impl Forager {
     }
 
     /// The nearest blob of the target colour.
-    fn nearest_food<'f>(&self, frame: &'f SensorFrame) -> Option<&'f swarm_runtime::messages::CameraBlob> {
+    fn nearest_food<'f>(
+        &self,
+        frame: &'f SensorFrame,
+    ) -> Option<&'f swarm_runtime::messages::CameraBlob> {
         // Blobs arrive nearest first.
         frame
             .camera_blobs()
@@ -333,7 +336,10 @@ fn light_on_left(frame: &SensorFrame) -> bool {
         .light
         .iter()
         .enumerate()
-        .fold((0, f32::MIN), |best, (i, &v)| if v > best.1 { (i, v) } else { best })
+        .fold(
+            (0, f32::MIN),
+            |best, (i, &v)| if v > best.1 { (i, v) } else { best },
+        )
         .0;
     brightest < 4
 }
@@ -407,11 +413,7 @@ pub fn rest<S: AsMut<Forager>>(s: &mut S, frame: &SensorFrame, command: &mut Act
 }
 
 /// `continue-rest`: another rest period begins.
-pub fn continue_rest<S: AsMut<Forager>>(
-    s: &mut S,
-    frame: &SensorFrame,
-    _: &mut ActuatorCommand,
-) {
+pub fn continue_rest<S: AsMut<Forager>>(s: &mut S, frame: &SensorFrame, _: &mut ActuatorCommand) {
     s.as_mut().phase_started = frame.tick;
 }
 
@@ -431,7 +433,10 @@ pub const fn procedures<S: AsRef<Forager> + AsMut<Forager>>() -> [(&'static str,
         ("have-food", Procedure::Check(have_food::<S>)),
         ("pick-ended", Procedure::Check(pick_ended::<S>)),
         ("drop-ended", Procedure::Check(drop_ended::<S>)),
-        ("did-search-expire", Procedure::Check(did_search_expire::<S>)),
+        (
+            "did-search-expire",
+            Procedure::Check(did_search_expire::<S>),
+        ),
         ("did-rest-expire", Procedure::Check(did_rest_expire::<S>)),
         ("Go", Procedure::Act(go::<S>)),
         ("rest-wait", Procedure::Act(go::<S>)),

@@ -136,7 +136,11 @@ pub fn follow_home_trail(
 const BASE: [(&str, Procedure<PheromoneForager>); 40] = foraging::procedures::<PheromoneForager>();
 
 /// Foraging action `I` of [`BASE`], then the trail deposit.
-fn laying<const I: usize>(s: &mut PheromoneForager, frame: &SensorFrame, command: &mut ActuatorCommand) {
+fn laying<const I: usize>(
+    s: &mut PheromoneForager,
+    frame: &SensorFrame,
+    command: &mut ActuatorCommand,
+) {
     if let Procedure::Act(act) = BASE[I].1 {
         act(s, frame, command);
     }
@@ -291,6 +295,9 @@ mod tests {
             ("home_channel", "1"),
         ]))
         .unwrap_err();
-        assert!(err.to_string().contains("must differ from food_channel"), "{err}");
+        assert!(
+            err.to_string().contains("must differ from food_channel"),
+            "{err}"
+        );
     }
 }
