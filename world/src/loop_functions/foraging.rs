@@ -253,12 +253,14 @@ impl LoopFunctions for Foraging {
 
     fn post_step(&mut self, arena: &mut Arena, _: &[ActuatorCommand], _: &[bool]) {
         self.ticks = arena.tick;
-        for i in 0..arena.gripper_events.len() {
+        // Taken out and put back (no allocation) so that deliveries may change the arena while we walk them.
+        let events = std::mem::take(&mut arena.gripper_events);
+        for &event in &events {
             if let GripperEvent::Dropped {
                 robot,
                 target,
                 position,
-            } = arena.gripper_events[i]
+            } = event
                 && (arena.robots[robot.index()].position.y <= self.params.home_y_max
                     || position.y <= self.params.home_y_max)
                 && arena.targets[target.index()].state == TargetState::InArena
@@ -266,6 +268,7 @@ impl LoopFunctions for Foraging {
                 self.deliver(arena, target);
             }
         }
+        arena.gripper_events = events;
         let (mut live, mut searching, mut resting) = (0u64, 0u64, 0u64);
         for r in arena.robots.iter().filter(|r| r.alive) {
             live += 1;

@@ -101,8 +101,10 @@ impl LoopFunctions for PheromoneForaging {
 
     fn post_step(&mut self, arena: &mut Arena, commands: &[ActuatorCommand], has: &[bool]) {
         self.foraging.post_step(arena, commands, has);
-        for i in 0..arena.gripper_events.len() {
-            let GripperEvent::Picked { robot, .. } = arena.gripper_events[i] else {
+        // Taken out and put back (no allocation) so that clearing may change the arena while we walk them.
+        let events = std::mem::take(&mut arena.gripper_events);
+        for &event in &events {
+            let GripperEvent::Picked { robot, .. } = event else {
                 continue;
             };
             let at = arena.robots[robot.index()].position;
@@ -116,6 +118,7 @@ impl LoopFunctions for PheromoneForaging {
                 self.erase_events += 1;
             }
         }
+        arena.gripper_events = events;
     }
 
     fn is_finished(&self, arena: &Arena) -> bool {
