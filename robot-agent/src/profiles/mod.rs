@@ -3,7 +3,9 @@
 //! [`bind_profile`] builds one robot's memory from its parameters and binds it to a supervisor set's events.
 
 pub mod aggregation;
+pub mod foraging;
 pub mod obstacle_avoidance;
+pub mod pheromone_foraging;
 pub mod synchronisation;
 pub mod timer;
 
@@ -17,7 +19,9 @@ use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
 use aggregation::Aggregation;
+use foraging::Forager;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
+use pheromone_foraging::PheromoneForager;
 use synchronisation::{Synchronisation, SynchronisationSct};
 
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
@@ -45,6 +49,8 @@ const PROFILES: &[(&str, BindFn)] = &[
     (Aggregation::NAME, bind_boxed::<Aggregation>),
     (Synchronisation::NAME, bind_boxed::<Synchronisation>),
     (SynchronisationSct::NAME, bind_boxed::<SynchronisationSct>),
+    (Forager::NAME, bind_boxed::<Forager>),
+    (PheromoneForager::NAME, bind_boxed::<PheromoneForager>),
 ];
 
 /// Why a profile could not be set up.
@@ -123,13 +129,13 @@ mod tests {
 
     #[test]
     fn unknown_profile_lists_the_known_ones() {
-        let err = bind_profile("foraging", &Params::default(), &[])
+        let err = bind_profile("flocking", &Params::default(), &[])
             .err()
             .unwrap();
         assert_eq!(
             err.to_string(),
-            "unknown profile `foraging` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct)"
+            "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging)"
         );
     }
 

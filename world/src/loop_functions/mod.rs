@@ -4,9 +4,11 @@
 
 pub mod aggregation;
 pub mod default;
+pub mod foraging;
 pub mod obstacle_avoidance;
 pub mod params;
 pub mod synchronisation;
+pub mod pheromone_foraging;
 
 use std::collections::BTreeMap;
 
@@ -69,7 +71,7 @@ pub struct LoopFunctionsRegistry {
 
 impl Default for LoopFunctionsRegistry {
     /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
-    /// `synchronisation_loop_functions`.
+    /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -82,6 +84,11 @@ impl Default for LoopFunctionsRegistry {
         registry.register(
             synchronisation::LABEL,
             synchronisation::Synchronisation::factory,
+        );
+        registry.register(foraging::LABEL, foraging::Foraging::factory);
+        registry.register(
+            pheromone_foraging::LABEL,
+            pheromone_foraging::PheromoneForaging::factory,
         );
         registry
     }

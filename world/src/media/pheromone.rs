@@ -116,6 +116,30 @@ impl PheromoneField {
         Vec2::new(gx, gy)
     }
 
+    /// Sets `channel` to zero in every cell whose centre lies within `radius` metres of `centre` (a loop function
+    /// erasing the trail of an exhausted source, tasks.md 5.2); returns how many cells held pheromone.
+    pub fn clear_disc(&mut self, channel: usize, centre: Vec2, radius: f32) -> usize {
+        if channel >= PHEROMONE_CHANNELS || !self.touched[channel] {
+            return 0;
+        }
+        let (lo, hi) = (
+            self.cell_of(centre - Vec2::splat(radius)),
+            self.cell_of(centre + Vec2::splat(radius)),
+        );
+        let mut cleared = 0;
+        for y in lo.1..=hi.1 {
+            for x in lo.0..=hi.0 {
+                let c = self.origin + Vec2::new(x as f32 + 0.5, y as f32 + 0.5) * self.cell;
+                let v = &mut self.values[(channel * self.ny + y) * self.nx + x];
+                if (c - centre).length() <= radius && *v > 0.0 {
+                    *v = 0.0;
+                    cleared += 1;
+                }
+            }
+        }
+        cleared
+    }
+
     /// One tick of evaporation and diffusion for every channel. The blur averages each cell's 3 x 3 neighbourhood
     /// (cells outside the arena do not count) and mixes it in with weight D.
     pub fn step(&mut self) {
@@ -192,5 +216,17 @@ mod tests {
         assert!(f.gradient(0, Vec2::new(0.01, 0.01)).x > 0.0);
         f.deposit(0, Vec2::new(0.06, 0.01), -5.0);
         assert_eq!(f.concentration(0, Vec2::new(0.06, 0.01)), 0.0);
+    }
+
+    #[test]
+    fn clear_disc_zeroes_only_the_cells_within_the_radius() {
+        let mut f = field(0.0, 0.0);
+        f.deposit(0, Vec2::new(0.01, 0.01), 1.0);
+        f.deposit(0, Vec2::new(0.51, 0.01), 1.0);
+        f.deposit(1, Vec2::new(0.01, 0.01), 1.0);
+        assert_eq!(f.clear_disc(0, Vec2::ZERO, 0.2), 1);
+        assert_eq!(f.concentration(0, Vec2::new(0.01, 0.01)), 0.0);
+        assert_eq!(f.concentration(0, Vec2::new(0.51, 0.01)), 1.0);
+        assert_eq!(f.concentration(1, Vec2::new(0.01, 0.01)), 1.0);
     }
 }
