@@ -434,7 +434,9 @@ impl Drop for Netns {
     fn drop(&mut self) {
         let _ = ip(&["link", "del", &self.outer]);
         let _ = ip(&["netns", "del", &self.name]);
+    }
 }
+
 /// Kills every process still running for runs starting with `run_prefix` and removes their shared-memory files
 /// and iceoryx2 root folders: the cleanup after a test killed a launcher on purpose (SIGKILL leaves them behind).
 pub fn wipe_runs(run_prefix: &str) {

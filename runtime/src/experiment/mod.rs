@@ -302,7 +302,7 @@ fn run_one(
         seed: Some(seed),
         out: Some(partial.clone()),
         progress: false,
-        tick_deadline: None,
+        ..RunOptions::default()
     };
     match launcher::run(&options, Arc::clone(stop)) {
         Ok(report) if report.interrupted => Outcome::Interrupted,

@@ -379,6 +379,8 @@ impl Share {
                 controller: controller.clone(),
                 seed: self.assignment.seed,
                 robots: self.assignment.robots_override,
+                compiled_supervisors: None,
+                resume: None,
             };
             let log_path = log_file(logs, *robot);
             let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
@@ -406,7 +408,7 @@ impl Share {
     fn wait_joined(&mut self, timeout: Duration, logs: &Path) -> Result<(), RemoteError> {
         let deadline = Instant::now() + timeout;
         loop {
-            let Some(link) = &self.link else {
+            let Some(link) = &mut self.link else {
                 return Ok(());
             };
             match link.wait_for_agents(IDLE_PERIOD) {

@@ -7,8 +7,8 @@ pub mod default;
 pub mod foraging;
 pub mod obstacle_avoidance;
 pub mod params;
-pub mod synchronisation;
 pub mod pheromone_foraging;
+pub mod synchronisation;
 
 use std::collections::BTreeMap;
 
