@@ -453,7 +453,11 @@ fn shipped_foraging_config_has_the_section_4_9_world() {
     }
     let d = &exp.arena.distributions;
     let quantities: Vec<u32> = d.iter().map(|d| d.quantity).collect();
-    assert_eq!(quantities, [40, 40, 10, 10]);
+    assert_eq!(
+        quantities,
+        [40, 40, 5, 5],
+        "40 robots, 40 targets, 5 boxes and 5 cylinders"
+    );
     assert!(matches!(d[1].template, Entity::Target(_)));
     match &d[0].position {
         PositionMethod::Uniform { max, .. } => assert!(max.y < -2.0, "robots start in home"),

@@ -4,10 +4,8 @@ use std::path::PathBuf;
 
 use swarm_runtime::config::Experiment;
 use swarm_runtime::messages::SensorFrame;
+use swarm_world::World;
 use swarm_world::entities::TargetState;
-use swarm_world::loop_functions::default::DefaultLoopFunctions;
-use swarm_world::loop_functions::{LoopFunctions, LoopFunctionsParams};
-use swarm_world::{LoopFunctionsRegistry, World, WorldError};
 
 fn load(relative: &str) -> Experiment {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -43,24 +41,10 @@ fn density_file_with_1000_robots_builds() {
     assert_eq!(world.arena.obstacles.len(), 4 + 200);
 }
 
-fn foraging_registry() -> LoopFunctionsRegistry {
-    // The foraging task registers its own loop functions; here any factory under the label will do.
-    fn factory(_: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
-        Ok(Box::new(DefaultLoopFunctions))
-    }
-    let mut registry = LoopFunctionsRegistry::default();
-    registry.register("foraging_loop_functions", factory);
-    registry
-}
-
 #[test]
 fn foraging_file_starts_robots_on_the_black_home_strip_with_the_lights_in_view() {
     let exp = load("configs/foraging/foraging.argos");
-    assert!(matches!(
-        World::new(&exp, 1),
-        Err(WorldError::UnknownLoopFunctions { .. })
-    ));
-    let mut world = World::with_registry(&exp, 1, &foraging_registry()).expect("builds");
+    let mut world = World::new(&exp, 1).expect("builds with the foraging loop functions");
     assert_eq!(world.robot_count(), 40);
     assert_eq!(world.arena.targets.len(), 40);
     assert!(
@@ -71,7 +55,7 @@ fn foraging_file_starts_robots_on_the_black_home_strip_with_the_lights_in_view()
             .all(|t| t.state == TargetState::InArena && t.placed.position.y >= -1.9)
     );
     assert_eq!(world.arena.lights.len(), 4);
-    assert_eq!(world.arena.obstacles.len(), 4 + 20);
+    assert_eq!(world.arena.obstacles.len(), 4 + 10);
     assert_eq!(world.max_ticks(), Some(144_000));
     let mut frames: Vec<SensorFrame> = (0..40).map(SensorFrame::empty).collect();
     world.sense(&mut frames);

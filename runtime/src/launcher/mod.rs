@@ -351,7 +351,13 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     if placement.is_none() {
         supervision.start_agents(&startup)?;
     }
-    let agent_pids: Vec<u32> = supervision.robots.iter().map(|r| r.first_pid).collect();
+    // Robots on hosts (and robots killed before they started) have no local process.
+    let agent_pids: Vec<u32> = supervision
+        .robots
+        .iter()
+        .map(|r| r.first_pid)
+        .filter(|&pid| pid != 0)
+        .collect();
     let followed = supervision.follow(&reports, &stop);
     if let Err(error) = followed {
         supervision.children.kill_all();
