@@ -1,37 +1,16 @@
 //! A control step is on the per-tick hot path: with the player and the bound profile, or a native controller,
 //! it must not allocate (style.md, "The hot path allocates nothing").
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::path::Path;
 
 use robot_agent::control;
 use robot_agent::controller;
 use robot_agent::params::Params;
+use swarm_runtime::alloc_count::{CountingAllocator, thread_allocations};
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Counts the allocations of the current thread.
-struct Counting;
-
-// SAFETY: forwards to the system allocator; the counter is a const-initialised thread local (no allocation).
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 fn allocations_in_1000_steps(element: &str) -> u64 {
     let params = Params::default();
@@ -41,12 +20,12 @@ fn allocations_in_1000_steps(element: &str) -> u64 {
     let mut obstacle = SensorFrame::empty(0);
     obstacle.proximity[7] = 0.6;
     let mut command = ActuatorCommand::idle(0, 0);
-    let before = ALLOCATIONS.with(Cell::get);
+    let before = thread_allocations();
     for tick in 0..1000u64 {
         let frame = if tick % 7 == 0 { &obstacle } else { &clear };
         control.step(frame, &mut command);
     }
-    ALLOCATIONS.with(Cell::get) - before
+    thread_allocations() - before
 }
 
 #[test]

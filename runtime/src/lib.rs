@@ -6,6 +6,7 @@
 //! experiment` ([`experiment`]). It never depends on the world or on the robot
 //! agent.
 
+pub mod alloc_count;
 pub mod bench;
 pub mod config;
 pub mod experiment;

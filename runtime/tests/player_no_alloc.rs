@@ -1,36 +1,14 @@
 //! The player's step is on the per-tick hot path: it must not allocate (style.md, "The hot path allocates nothing").
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use supervisor_gen::compiled::{
     CompiledEvent, CompiledState, CompiledSupervisor, CompiledTransition, SupervisorSet,
 };
+use swarm_runtime::alloc_count::{CountingAllocator, thread_allocations};
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_runtime::player::{EventCallbacks, Player};
 
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Counts the allocations of the current thread.
-struct Counting;
-
-// SAFETY: forwards to the system allocator; the counter is a const-initialised thread local (no allocation).
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 struct Toggle;
 
@@ -108,10 +86,10 @@ fn player_step_allocates_nothing() {
         frame.tick = tick;
         player.step(&frame, &mut callbacks, &mut command);
     }
-    let before = ALLOCATIONS.with(Cell::get);
+    let before = thread_allocations();
     for tick in 11..=1_000 {
         frame.tick = tick;
         player.step(&frame, &mut callbacks, &mut command);
     }
-    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0);
+    assert_eq!(thread_allocations() - before, 0);
 }

@@ -89,12 +89,16 @@ pub fn swarm(args: &[&str]) -> SwarmOutcome {
 
 /// Shared-memory files left by runs whose name starts with `run_prefix`.
 pub fn shm_leftovers(run_prefix: &str) -> Vec<PathBuf> {
-    let prefix = format!("iox2_{run_prefix}");
-    std::fs::read_dir("/dev/shm")
+    entries_starting_with(Path::new("/dev/shm"), &format!("iox2_{run_prefix}"))
+}
+
+/// Entries of `dir` whose file name starts with `prefix` (none if `dir` cannot be read).
+fn entries_starting_with(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
         .map(|entries| {
             entries
                 .flatten()
-                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+                .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
                 .map(|e| e.path())
                 .collect()
         })
@@ -119,51 +123,35 @@ pub fn process_leftovers(run_prefix: &str) -> Vec<u32> {
         .unwrap_or_default()
 }
 
-/// Asserts that the runs of `outcome` left no process and no shared-memory file.
+/// Asserts that the runs of `outcome` left no process, no shared-memory file and no iceoryx2 root directory.
 pub fn assert_clean(outcome: &SwarmOutcome) {
-    let prefix = outcome.run_prefix();
-    assert_eq!(
-        process_leftovers(&prefix),
-        Vec::<u32>::new(),
-        "processes outlived the run"
-    );
-    assert_eq!(
-        shm_leftovers(&prefix),
-        Vec::<PathBuf>::new(),
-        "shared memory outlived the run"
-    );
+    assert_prefix_clean(&outcome.run_prefix());
 }
 
 /// iceoryx2 root directories (`$TMPDIR/iceoryx2-<run>`) left by runs whose name starts with `run_prefix`.
 pub fn iceoryx_root_leftovers(run_prefix: &str) -> Vec<PathBuf> {
-    let prefix = format!("iceoryx2-{run_prefix}");
-    std::fs::read_dir(std::env::temp_dir())
-        .map(|entries| {
-            entries
-                .flatten()
-                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
-                .map(|e| e.path())
-                .collect()
-        })
-        .unwrap_or_default()
+    entries_starting_with(&std::env::temp_dir(), &format!("iceoryx2-{run_prefix}"))
 }
 
 /// Asserts that the runs of the launcher with process id `pid` left no process, no shared-memory file and no
 /// iceoryx2 root directory, whatever was killed during them.
 pub fn assert_nothing_left(pid: u32) {
-    let prefix = format!("sw{pid:x}-");
+    assert_prefix_clean(&format!("sw{pid:x}-"));
+}
+
+fn assert_prefix_clean(prefix: &str) {
     assert_eq!(
-        process_leftovers(&prefix),
+        process_leftovers(prefix),
         Vec::<u32>::new(),
         "processes outlived the run"
     );
     assert_eq!(
-        shm_leftovers(&prefix),
+        shm_leftovers(prefix),
         Vec::<PathBuf>::new(),
         "shared memory outlived the run"
     );
     assert_eq!(
-        iceoryx_root_leftovers(&prefix),
+        iceoryx_root_leftovers(prefix),
         Vec::<PathBuf>::new(),
         "iceoryx2 files outlived the run"
     );

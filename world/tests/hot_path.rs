@@ -1,43 +1,18 @@
 //! The world's own hot path allocates nothing: once warmed up, `sense` makes no heap allocation at all. (The
 //! rapier2d step inside `act_and_step` allocates about ten small buffers per tick internally; everything of ours
-//! around it reuses preallocated buffers.) Counted with a wrapping global allocator; this file is its own test
+//! around it reuses preallocated buffers.) Counted with swarm_runtime's counting global allocator (this thread only); this file is its own test
 //! binary, so the allocator affects nothing else.
 
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use common::config::thesis_example;
+use swarm_runtime::alloc_count::{CountingAllocator, thread_allocations};
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::World;
 use swarm_world::in_process::avoid_obstacles;
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn sensing_allocates_nothing_after_warm_up() {
@@ -49,10 +24,10 @@ fn sensing_allocates_nothing_after_warm_up() {
     let has = vec![true; n];
     let mut sensing = 0;
     for tick in 0..500 {
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        let before = thread_allocations();
         world.sense(&mut frames);
         if tick >= 400 {
-            sensing += ALLOCATIONS.load(Ordering::Relaxed) - before;
+            sensing += thread_allocations() - before;
         }
         for (f, c) in frames.iter().zip(commands.iter_mut()) {
             avoid_obstacles(f, c);
