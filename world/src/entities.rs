@@ -65,8 +65,11 @@ pub struct Robot {
     pub heading: f32,
     /// LED colour (off when dead).
     pub led: Rgb,
-    /// Whether the robot is alive; a dead robot is an inert obstacle.
+    /// Whether the robot is alive; a dead robot is an inert obstacle (or removed).
     pub alive: bool,
+    /// Whether its dead body has left the arena (`<faults dead_bodies="removed">`): it collides with nothing
+    /// and no sensor sees it.
+    pub removed: bool,
     /// Wheel speeds applied in the last tick, in cm/s, after clamping and noise.
     pub wheels: [f32; 2],
     /// The target the virtual gripper carries.

@@ -34,6 +34,17 @@ pub struct Aabb {
 }
 
 impl Aabb {
+    /// The empty box: lies nowhere, so a grid lists it in no cell.
+    pub const NOWHERE: Aabb = Aabb {
+        min: Vec2::splat(f32::INFINITY),
+        max: Vec2::splat(f32::NEG_INFINITY),
+    };
+
+    /// Whether this is [`Aabb::NOWHERE`] (or any box with a lower corner above its upper one).
+    pub fn is_nowhere(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y
+    }
+
     /// The box around a disc of `radius` at `centre`.
     pub fn around(centre: Vec2, radius: f32) -> Self {
         Self {

@@ -78,6 +78,10 @@ impl Scene {
         }
         self.aabbs.clear();
         self.aabbs.extend(self.shapes.iter().map(Placed::aabb));
+        // A removed body keeps its index (robot index = scene index) but is in no grid cell, so nothing finds it.
+        for (aabb, _) in self.aabbs.iter_mut().zip(robots).filter(|(_, r)| r.removed) {
+            *aabb = Aabb::NOWHERE;
+        }
         self.grid.rebuild(&self.aabbs);
     }
 

@@ -47,11 +47,12 @@ impl Grid {
         )
     }
 
-    /// Replaces the contents with `aabbs`; item `i` is `aabbs[i]`. Boxes outside the grid land in its border cells.
+    /// Replaces the contents with `aabbs`; item `i` is `aabbs[i]`. Boxes outside the grid land in its border cells;
+    /// [`Aabb::NOWHERE`] items are in no cell.
     pub fn rebuild(&mut self, aabbs: &[Aabb]) {
         self.starts.iter_mut().for_each(|s| *s = 0);
         let mut total = 0usize;
-        for aabb in aabbs {
+        for aabb in aabbs.iter().filter(|a| !a.is_nowhere()) {
             let (x0, x1, y0, y1) = self.cell_range(aabb);
             for y in y0..=y1 {
                 for x in x0..=x1 {
@@ -65,7 +66,12 @@ impl Grid {
         }
         self.items.resize(total, 0);
         // Fill backwards from each cell's end so the prefix sums double as write cursors.
-        for (i, aabb) in aabbs.iter().enumerate().rev() {
+        for (i, aabb) in aabbs
+            .iter()
+            .enumerate()
+            .rev()
+            .filter(|(_, a)| !a.is_nowhere())
+        {
             let (x0, x1, y0, y1) = self.cell_range(aabb);
             for y in y0..=y1 {
                 for x in x0..=x1 {

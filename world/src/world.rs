@@ -7,6 +7,7 @@
 //! own per step).
 
 use swarm_runtime::config::Experiment;
+use swarm_runtime::config::faults::DeadBodies;
 use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use crate::actuators;
@@ -96,6 +97,7 @@ impl WorldBuilder {
             heading,
             led: swarm_runtime::messages::Rgb::OFF,
             alive: true,
+            removed: false,
             wheels: [0.0; 2],
             carrying: None,
             collisions: 0,
@@ -204,6 +206,7 @@ impl WorldBuilder {
             loop_functions: self.loop_functions,
             scratch: Vec::with_capacity(64),
             max_ticks: None,
+            dead_bodies: DeadBodies::Inert,
         };
         world.update_media();
         world
@@ -220,6 +223,7 @@ pub struct World {
     loop_functions: Box<dyn LoopFunctions>,
     scratch: Vec<u32>,
     max_ticks: Option<u64>,
+    dead_bodies: DeadBodies,
 }
 
 impl World {
@@ -275,7 +279,13 @@ impl World {
             .unwrap_or_else(|| floor_grey(&self.arena.floor, p))
     }
 
-    /// Marks a robot alive or dead. A dead robot stays as an inert obstacle with its LED off and never acts.
+    /// Sets what becomes of the bodies of robots that die from now on (default: they stay, inert).
+    pub fn set_dead_bodies(&mut self, dead_bodies: DeadBodies) {
+        self.dead_bodies = dead_bodies;
+    }
+
+    /// Marks a robot alive or dead. A dead robot never acts and its LED is off; its body stays as an inert
+    /// obstacle or, with [`DeadBodies::Removed`], leaves the arena until the robot is alive again.
     pub fn set_alive(&mut self, robot: RobotId, alive: bool) {
         let Some(r) = self.arena.robots.get_mut(robot.index()) else {
             return;
@@ -285,6 +295,17 @@ impl World {
             r.led = swarm_runtime::messages::Rgb::OFF;
             r.wheels = [0.0; 2];
             self.arena.physics.drive(r.handles.body, 0.0, 0.0);
+        }
+        let removed = !alive && self.dead_bodies == DeadBodies::Removed;
+        if r.removed != removed {
+            r.removed = removed;
+            self.arena.physics.set_enabled(r.handles, !removed);
+            // The next frames must already see the arena without (or with) the body.
+            self.scene.rebuild(
+                &self.arena.robots,
+                &self.arena.obstacles,
+                &self.arena.targets,
+            );
         }
         self.leds
             .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);

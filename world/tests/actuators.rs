@@ -3,6 +3,7 @@
 mod common;
 
 use common::{TPS, builder, drive, frames, wall, wheels};
+use swarm_runtime::config::faults::DeadBodies;
 use swarm_runtime::messages::{ActuatorCommand, GripperAction, Rgb};
 use swarm_world::arena::GripperEvent;
 use swarm_world::devices::Devices;
@@ -171,6 +172,57 @@ fn dead_robot_holds_still_with_its_led_off_and_reports_not_alive() {
     assert_eq!(world.arena.robots[0].position, before);
     assert_eq!(world.arena.robots[0].led, Rgb::OFF);
     assert_eq!(frames(&mut world)[0].alive, 0);
+}
+
+/// Robot 0 at the origin facing +x, robot 1 (dead) 9 cm ahead of it, with dead bodies `dead_bodies`.
+fn dead_robot_ahead(dead_bodies: DeadBodies) -> swarm_world::World {
+    let mut b = builder();
+    b.robot("r0", "c", Vec2::ZERO, 0.0, Devices::ALL);
+    let dead = b.robot("r1", "c", Vec2::new(0.09, 0.0), 0.0, Devices::ALL);
+    let mut world = b.build();
+    world.set_dead_bodies(dead_bodies);
+    world.set_alive(dead, false);
+    world
+}
+
+#[test]
+fn inert_dead_body_is_seen_and_pushed_aside() {
+    let mut world = dead_robot_ahead(DeadBodies::Inert);
+    assert!(frames(&mut world)[0].proximity[0] > 0.0, "the body is seen");
+    drive(&mut world, 40, wheels(10.0, 10.0));
+    assert_eq!(world.arena.robots[0].collisions, 1);
+    assert!(
+        world.arena.robots[1].position.x > 0.1,
+        "the body was pushed: {}",
+        world.arena.robots[1].position.x
+    );
+}
+
+#[test]
+fn removed_dead_body_is_neither_seen_nor_hit_and_comes_back_with_its_robot() {
+    let mut world = dead_robot_ahead(DeadBodies::Removed);
+    assert!(world.arena.robots[1].removed);
+    assert_eq!(frames(&mut world)[0].proximity, [0.0; 8], "nothing seen");
+    drive(&mut world, 40, wheels(10.0, 10.0));
+    assert!(
+        world.arena.robots[0].position.x > 0.09 + 2.0 * ROBOT_RADIUS,
+        "drove through where the body was: {}",
+        world.arena.robots[0].position.x
+    );
+    assert_eq!(world.arena.robots[0].collisions, 0);
+    assert_eq!(world.arena.robots[1].position, Vec2::new(0.09, 0.0));
+
+    world.set_alive(RobotId(1), true);
+    assert!(!world.arena.robots[1].removed);
+    let backwards = [wheels(-10.0, -10.0), wheels(0.0, 0.0)];
+    for _ in 0..40 {
+        world.act_and_step(&backwards, &[true, false]);
+    }
+    assert_eq!(
+        world.arena.robots[0].collisions, 1,
+        "backing up, robot 0 hits the restarted robot"
+    );
+    assert!(world.arena.robots[1].position.x < 0.08);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! The fault schedule of a run: the `<faults>` extension section of a `.argos` file and `swarm run --fault`.
 //!
 //! ```xml
-//! <faults>
+//! <faults dead_bodies="inert">              <!-- or "removed": a dead robot's body leaves the arena -->
 //!   <kill robots="3,7" tick="50"/>            <!-- or time="5.0" (seconds) -->
 //!   <kill fraction="0.1" time="2.0"/>         <!-- a seeded random 10% of the live robots -->
 //!   <chaos every="1.5" count="2" stop="9"/>   <!-- every 1.5 s from t = 1.5 s: kill 2 random live robots -->
@@ -33,6 +33,16 @@ pub const DEFAULT_MAX_RESTARTS: u32 = 3;
 pub const DEFAULT_RESTART_WINDOW: f64 = 60.0;
 /// Default `backoff` in seconds.
 pub const DEFAULT_BACKOFF: f64 = 0.1;
+
+/// What becomes of a dead robot's body (`<faults dead_bodies>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DeadBodies {
+    /// It stays where it died as an inert obstacle with its LEDs off (the default).
+    #[default]
+    Inert,
+    /// It leaves the arena: no collisions, nothing senses it; it comes back where it was if the robot restarts.
+    Removed,
+}
 
 /// What a scheduled fault does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -173,6 +183,8 @@ pub struct FaultSchedule {
     pub faults: Vec<ScheduledFault>,
     /// Restart rules; for each robot the last matching rule applies.
     pub restarts: Vec<RestartRule>,
+    /// What becomes of dead robots' bodies.
+    pub dead_bodies: DeadBodies,
 }
 
 impl FaultSchedule {
@@ -201,6 +213,7 @@ impl FaultSchedule {
             errors.extend(ctx.into_errors());
             schedule.faults.extend(part.faults);
             schedule.restarts.extend(part.restarts);
+            schedule.dead_bodies = part.dead_bodies;
         }
         for (i, text) in cli.iter().enumerate() {
             let path = PathBuf::from(format!("--fault #{}", i + 1));
@@ -264,7 +277,7 @@ impl FaultSchedule {
             })
     }
 
-    /// Whether the schedule does anything at all.
+    /// Whether the schedule has no fault and no restart rule (`dead_bodies` alone changes nothing).
     pub fn is_empty(&self) -> bool {
         self.faults.is_empty() && self.restarts.is_empty()
     }
@@ -276,8 +289,11 @@ pub(crate) fn check_section(ctx: &mut Ctx, el: &Element) {
 }
 
 fn read_section(ctx: &mut Ctx, el: &Element) -> FaultSchedule {
-    ctx.unknown_attributes(el, &[]);
-    let mut schedule = FaultSchedule::default();
+    ctx.unknown_attributes(el, &["dead_bodies"]);
+    let mut schedule = FaultSchedule {
+        dead_bodies: dead_bodies(ctx, el),
+        ..FaultSchedule::default()
+    };
     for child in &el.children {
         read_child(ctx, child, &mut schedule);
     }
@@ -475,6 +491,25 @@ fn chaos(ctx: &mut Ctx, el: &Element, origin: Origin) -> Option<ScheduledFault> 
         targets: Targets::Count(count?),
         origin,
     })
+}
+
+fn dead_bodies(ctx: &mut Ctx, el: &Element) -> DeadBodies {
+    match ctx.attr::<String>(el, "dead_bodies").as_deref() {
+        None | Some("inert") => DeadBodies::Inert,
+        Some("removed") => DeadBodies::Removed,
+        Some(other) => {
+            let at = el
+                .attributes
+                .get("dead_bodies")
+                .map_or(el.location, |a| a.location);
+            ctx.error(
+                at,
+                format!("invalid 'dead_bodies' in <faults>: '{other}' is not inert or removed"),
+                None,
+            );
+            DeadBodies::Inert
+        }
+    }
 }
 
 fn restart_rule(ctx: &mut Ctx, el: &Element, origin: Origin) -> Option<RestartRule> {
@@ -718,5 +753,22 @@ mod tests {
         assert_eq!(parse_robot_list("4, 0,2-3").unwrap(), vec![0, 2, 3, 4]);
         assert!(parse_robot_list("5-2").is_err());
         assert!(parse_robot_list("a").is_err());
+    }
+
+    #[test]
+    fn dead_bodies_default_to_inert_and_read_removed() {
+        assert_eq!(
+            load("<faults/>", &[]).unwrap().dead_bodies,
+            DeadBodies::Inert
+        );
+        let schedule = load("<faults dead_bodies=\"removed\"/>", &[]).unwrap();
+        assert_eq!(schedule.dead_bodies, DeadBodies::Removed);
+        let err = load("<faults dead_bodies=\"gone\"/>", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(":3:9:") && err.contains("'gone' is not inert or removed"),
+            "{err}"
+        );
     }
 }

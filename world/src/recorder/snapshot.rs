@@ -78,7 +78,7 @@ pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
         width: 0.004,
         ..Stroke::default()
     };
-    for r in &arena.robots {
+    for r in arena.robots.iter().filter(|r| !r.removed) {
         let body = Placed::new(
             Shape::Disc {
                 radius: ROBOT_RADIUS,

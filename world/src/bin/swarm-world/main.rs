@@ -88,6 +88,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .map(|c| c.id.as_str())
         .collect();
     let schedule = FaultSchedule::load(&args.config, &args.faults, robots as u32, &controller_ids)?;
+    world.set_dead_bodies(schedule.dead_bodies);
     let roster: Vec<(String, String)> = experiment
         .arena
         .robots()
