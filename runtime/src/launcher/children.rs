@@ -54,6 +54,13 @@ impl Children {
         exited
     }
 
+    /// SIGKILLs `robot`'s agent and reaps it; its exit status, or `None` if it had no running agent.
+    pub fn kill_agent(&mut self, robot: u32) -> Option<ExitStatus> {
+        let mut child = self.agents.get_mut(robot as usize)?.take()?;
+        signal(&child, Signal::SIGKILL);
+        child.wait().ok()
+    }
+
     /// Number of agent processes not yet reaped.
     pub fn agents_running(&self) -> usize {
         self.agents.iter().filter(|a| a.is_some()).count()

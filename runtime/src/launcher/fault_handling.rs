@@ -241,8 +241,9 @@ impl Supervision {
             (CtlCommand::Kill(_), _) => {
                 self.robots[robot as usize].ctl_killed = true;
                 self.robots[robot as usize].gone_at = Some(Instant::now());
-                if let Some(Some(child)) = self.children.agents.get(robot as usize) {
-                    children::signal(child, Signal::SIGKILL);
+                // Reaped here, so the world hears of the death in this round, not at the next poll.
+                if let Some(status) = self.children.kill_agent(robot) {
+                    self.reaped.push((robot, status));
                 }
                 Ok(format!("robot {robot} killed\n"))
             }
@@ -321,12 +322,7 @@ impl Supervision {
 
     /// SIGKILLs `robot`'s agent and reaps it, so its end is not seen again as an unscheduled death.
     fn kill_and_reap(&mut self, robot: u32) {
-        if let Some(slot) = self.children.agents.get_mut(robot as usize)
-            && let Some(mut child) = slot.take()
-        {
-            children::signal(&child, Signal::SIGKILL);
-            let _ = child.wait();
-        }
+        self.children.kill_agent(robot);
         self.robots[robot as usize].state = AgentState::Dead;
     }
 

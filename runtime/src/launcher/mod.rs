@@ -34,7 +34,7 @@ pub mod world_report;
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{ChildStdin, Command, Stdio};
+use std::process::{ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
@@ -346,6 +346,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         ticks_per_second,
         faults: Vec::new(),
         pending_restarts: Vec::new(),
+        reaped: Vec::new(),
         control,
     };
     if placement.is_none() {
@@ -550,6 +551,8 @@ struct Supervision {
     faults: Vec<FaultRecord>,
     /// Replacement agents to start once their backoff has passed (robot, when).
     pending_restarts: Vec<(u32, Instant)>,
+    /// Agents the launcher killed and reaped itself (`swarm ctl kill`), whose exit is still to be handled.
+    reaped: Vec<(u32, ExitStatus)>,
     control: Option<ControlServer>,
 }
 
@@ -612,9 +615,9 @@ impl Supervision {
                     });
                 }
             }
+            self.answer_control();
             self.handle_agent_exits()?;
             self.start_due_restarts()?;
-            self.answer_control();
         }
     }
 
@@ -628,7 +631,9 @@ impl Supervision {
     /// Reaps exited agents: before the first tick an exit is a failed start; afterwards an unsuccessful exit is a
     /// death the world hears of at once (a successful one means the world already ended the run).
     fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
-        for (robot, status) in self.children.reap_agents() {
+        let mut exits = std::mem::take(&mut self.reaped);
+        exits.extend(self.children.reap_agents());
+        for (robot, status) in exits {
             if self.first_tick.is_none() && !self.robots[robot as usize].ctl_killed {
                 let log =
                     run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);

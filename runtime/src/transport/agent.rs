@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::reader::{EntryHandle, Reader};
+use iceoryx2::port::reader::{EntryHandle, Reader, ReaderCreateError};
 use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
 use iceoryx2::prelude::ipc;
 
@@ -109,11 +109,16 @@ impl AgentLink {
                     waited_ms: waited.elapsed().as_millis(),
                 })?;
         let node = services::node(run, &format!("robot-{robot}"))?;
-        let frame_board = services::open_frame_board(&node)?;
-        let frame_reader = frame_board
-            .reader_builder()
-            .create()
-            .map_err(|e| TransportError::iceoryx("reading the frame board", e))?;
+        let frame_board = services::open_frame_board(&node, robot, sync.capacity())?;
+        let frame_reader = frame_board.reader_builder().create().map_err(|e| match e {
+            ReaderCreateError::ExceedsMaxSupportedReaders => TransportError::ServiceFull {
+                robot,
+                service: services::frame_service_name(),
+                limit: sync.capacity() as usize + services::SPARE_AGENT_PLACES,
+                what: "readers",
+            },
+            other => TransportError::iceoryx("reading the frame board", other),
+        })?;
         let frame_entry = frame_reader
             .entry::<SensorFrame>(&robot)
             .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s frame entry"), e))?;

@@ -11,6 +11,7 @@
 //! [`WorldLink`] is the world's side, [`AgentLink`] an agent's side, [`RunSpec`] names a run and cleans it up.
 
 mod agent;
+mod cleaner;
 mod futex;
 mod run;
 mod services;

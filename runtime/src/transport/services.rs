@@ -53,7 +53,11 @@ pub(crate) fn node(run: &RunSpec, name: &str) -> Result<Node<ipc::Service>, Tran
         })
 }
 
-/// World side: creates the frame board with one entry per robot, readable by `robots` agents.
+/// Places in the frame board beyond one per robot: replacement agents connect while their dead predecessors'
+/// places still wait for the dead-node cleanup. More simultaneous replacements retry until it has run.
+pub(crate) const SPARE_AGENT_PLACES: usize = 8;
+
+/// World side: creates the frame board with one entry per robot, readable by `robots` agents (plus spares).
 pub(crate) fn create_frame_board(
     node: &Node<ipc::Service>,
     robots: u32,
@@ -62,8 +66,8 @@ pub(crate) fn create_frame_board(
     let mut creator = node
         .service_builder(&service_name(&name)?)
         .blackboard_creator::<u32>()
-        .max_readers(robots as usize)
-        .max_nodes(robots as usize + 1);
+        .max_readers(robots as usize + SPARE_AGENT_PLACES)
+        .max_nodes(robots as usize + 1 + SPARE_AGENT_PLACES);
     for robot in 0..robots {
         creator = creator.add::<SensorFrame>(robot, SensorFrame::empty(robot));
     }
@@ -72,13 +76,14 @@ pub(crate) fn create_frame_board(
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }
 
-/// Agent side: opens the frame board.
-pub(crate) fn open_frame_board(node: &Node<ipc::Service>) -> Result<Board, TransportError> {
-    let name = frame_service_name();
-    node.service_builder(&service_name(&name)?)
-        .blackboard_opener::<u32>()
-        .open()
-        .map_err(|e| TransportError::iceoryx(format!("opening service {name}"), e))
+/// Agent side: opens the frame board of a run of `robots` robots as robot `robot`'s agent.
+pub(crate) fn open_frame_board(
+    node: &Node<ipc::Service>,
+    robot: u32,
+    robots: u32,
+) -> Result<Board, TransportError> {
+    let nodes = robots as usize + 1 + SPARE_AGENT_PLACES;
+    open_board(node, robot, &frame_service_name(), nodes)
 }
 
 /// World side: creates generation `generation` of robot `robot`'s command board (one writer, the robot's
@@ -104,15 +109,30 @@ pub(crate) fn open_command_board(
     robot: u32,
     generation: u32,
 ) -> Result<Board, TransportError> {
-    let name = command_service_name(robot, generation);
-    node.service_builder(&service_name(&name)?)
+    open_board(
+        node,
+        robot,
+        &command_service_name(robot, generation),
+        COMMAND_NODES,
+    )
+}
+
+/// Opens the board `name` for robot `robot`'s agent; a board whose `nodes` places are taken is
+/// [`TransportError::ServiceFull`] (the agent may retry once dead nodes are cleaned up).
+fn open_board(
+    node: &Node<ipc::Service>,
+    robot: u32,
+    name: &str,
+    nodes: usize,
+) -> Result<Board, TransportError> {
+    node.service_builder(&service_name(name)?)
         .blackboard_opener::<u32>()
         .open()
         .map_err(|e| match e {
             BlackboardOpenError::ExceedsMaxNumberOfNodes => TransportError::ServiceFull {
                 robot,
-                service: name.clone(),
-                limit: COMMAND_NODES,
+                service: name.to_owned(),
+                limit: nodes,
                 what: "nodes",
             },
             other => TransportError::iceoryx(format!("opening service {name}"), other),

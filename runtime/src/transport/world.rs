@@ -15,6 +15,7 @@ use iceoryx2::port::writer::{EntryHandleMut, Writer};
 use iceoryx2::prelude::ipc;
 
 use super::TransportError;
+use super::cleaner::Cleaner;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{MAX_ROBOTS, SyncBlock};
@@ -38,8 +39,8 @@ pub struct LinkConfig {
     /// How long the world busy-waits for answers before it sleeps on the counter (default 20 us). Spinning
     /// saves a wake-up when agents answer fast; longer spins steal the CPU the agents need on small machines.
     pub spin: Duration,
-    /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice triggers
-    /// one at the next tick as well.
+    /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice or a
+    /// replacement agent's request triggers one at once as well. Removals run on a thread of their own.
     pub cleanup_interval: u64,
 }
 
@@ -155,6 +156,7 @@ pub struct WorldLink {
     notices_handled: u64,
     board_requests_handled: u32,
     last_cleanup: u64,
+    cleaner: Cleaner,
     node: Node<ipc::Service>,
 }
 
@@ -170,6 +172,7 @@ impl WorldLink {
         }
         let node = services::node(run, "world")?;
         let boards = Self::create_boards(&node, robots)?;
+        let cleaner = Cleaner::start(run.iceoryx_config()?)?;
         // Last, so that a failure above leaves no sync block behind (iceoryx2 removes its own resources on drop).
         let sync = Arc::new(SyncBlock::create(&run.sync_block_path(), robots)?);
         tracing::debug!(run = run.name(), robots, "world link created");
@@ -186,6 +189,7 @@ impl WorldLink {
             notices_handled: 0,
             board_requests_handled: 0,
             last_cleanup: 0,
+            cleaner,
             node,
             config,
         })
@@ -247,14 +251,14 @@ impl WorldLink {
         }
     }
 
-    /// Renews the command boards replacement agents asked for, after removing dead agents' iceoryx2 resources.
+    /// Renews the command boards replacement agents asked for, and has the dead agents' iceoryx2 resources
+    /// removed (their places in the frame board; the frame board's spare places let replacements in before).
     fn serve_board_requests(&mut self) {
         let requests = self.deaths.sync.board_requests();
         if requests != self.board_requests_handled {
             self.board_requests_handled = requests;
-            let state = self.node.try_cleanup_dead_nodes();
-            tracing::debug!(?state, "dead-node cleanup for a replacement agent");
             self.renew_requested_boards();
+            self.cleaner.request();
         }
     }
 
@@ -352,8 +356,7 @@ impl WorldLink {
         {
             self.notices_handled = notices;
             self.last_cleanup = tick;
-            let state = self.node.try_cleanup_dead_nodes();
-            tracing::debug!(tick, ?state, "dead-node cleanup");
+            self.cleaner.request();
         }
     }
 
