@@ -2,10 +2,12 @@
 //! failure (unknown controller or profile, bad supervisor file, unbound event, bad parameter) exits non-zero with
 //! the reason for the launcher to report; then joins the run and answers every tick: wait for the frame, step
 //! the controller, send the command. A restarted agent (`--resume`) continues from the world's record
-//! ([`robot_agent::resume`]).
+//! ([`robot_agent::resume`]). SIGTERM or SIGINT asks the agent to leave the run: it stops at its next tick
+//! without answering it and exits 0 (the launcher restarts it only under the `always` policy).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
@@ -198,6 +200,10 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
     let mut command = ActuatorCommand::idle(args.robot, 0);
     while let Some(tick) = link.next_tick().context("waiting for a tick")? {
+        if STOP_REQUESTED.load(Ordering::Relaxed) {
+            info!(robot = args.robot, "asked to stop: leaving the run");
+            return Ok(());
+        }
         if resumer.before_step(control, tick.frame())? {
             control.step(tick.frame(), &mut command);
         } else {
@@ -206,6 +212,29 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
         link.answer(tick, &command).context("answering a tick")?;
     }
     info!(robot = args.robot, "the world ended the run");
+    Ok(())
+}
+
+/// Set by SIGTERM and SIGINT.
+static STOP_REQUESTED: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn request_stop(_: nix::libc::c_int) {
+    STOP_REQUESTED.store(true, Ordering::Relaxed);
+}
+
+/// Makes SIGTERM and SIGINT ask the agent to leave the run instead of killing it.
+fn install_stop_handler() -> Result<()> {
+    use nix::sys::signal::{SaFlags, SigAction, SigHandler, SigSet, Signal, sigaction};
+    let action = SigAction::new(
+        SigHandler::Handler(request_stop),
+        SaFlags::SA_RESTART,
+        SigSet::empty(),
+    );
+    for signal in [Signal::SIGTERM, Signal::SIGINT] {
+        // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+        unsafe { sigaction(signal, &action) }
+            .with_context(|| format!("installing the {signal} handler"))?;
+    }
     Ok(())
 }
 
@@ -220,6 +249,7 @@ fn run(args: &Args) -> Result<()> {
         println!("{}", serde_json::to_string(&control.event_names())?);
         return Ok(());
     };
+    install_stop_handler()?;
     serve(args, root, &mut control)
         .with_context(|| format!("robot {} in run {}", args.robot, args.run))
 }

@@ -4,11 +4,13 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::Command;
+use std::process::{Child, ChildStderr, Command};
 
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
-use swarm_system_tests::{SwarmOutcome, assert_nothing_left, bin_dir, spawn_swarm, swarm};
+use swarm_system_tests::{
+    SwarmOutcome, assert_nothing_left, bin_dir, remove_run_leftovers, spawn_swarm, swarm,
+};
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
 const ROBOTS: usize = 40;
@@ -370,46 +372,120 @@ fn same_seed_and_fault_schedule_give_identical_records() {
     );
 }
 
-/// Runs `swarm ctl <out> <request>` and returns its standard output.
-fn ctl(out: &Path, request: &[&str]) -> String {
-    let output = Command::new(bin_dir().join("swarm"))
-        .arg("ctl")
-        .arg(out)
-        .args(request)
-        .output()
-        .expect("swarm ctl runs");
-    assert!(
-        output.status.success(),
-        "swarm ctl {request:?} failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    String::from_utf8_lossy(&output.stdout).into_owned()
+/// A `swarm run` of the 40-robot experiment that goes on until it is interrupted, followed from its first tick.
+/// Dropping it unfinished (a failed assertion) kills the launcher, whose children die with it, and removes the
+/// run's shared memory.
+struct LiveRun {
+    child: Child,
+    stderr: BufReader<ChildStderr>,
+    out: tempfile::TempDir,
+}
+
+impl LiveRun {
+    /// Starts the run for at most `ticks` ticks with `extra` arguments and returns once its first tick has
+    /// completed.
+    fn start(ticks: u64, extra: &[&str]) -> LiveRun {
+        let out = temp_dir();
+        let out_arg = out.path().display().to_string();
+        let ticks = ticks.to_string();
+        let mut args = vec![
+            "run",
+            OBSTACLE_AVOIDANCE,
+            "--no-progress",
+            "--ticks",
+            ticks.as_str(),
+            "--tick-deadline-ms",
+            "100",
+            "--out",
+            out_arg.as_str(),
+        ];
+        args.extend(extra);
+        let mut child = spawn_swarm(&args);
+        let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
+        let mut line = String::new();
+        while stderr.read_line(&mut line).expect("the launcher's log") > 0
+            && !line.contains("first tick completed")
+        {
+            line.clear();
+        }
+        LiveRun { child, stderr, out }
+    }
+
+    /// Runs `swarm ctl <out> <request>` and returns its standard output.
+    fn ctl(&self, request: &[&str]) -> String {
+        let output = Command::new(bin_dir().join("swarm"))
+            .arg("ctl")
+            .arg(self.out.path())
+            .args(request)
+            .output()
+            .expect("swarm ctl runs");
+        assert!(
+            output.status.success(),
+            "swarm ctl {request:?} failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    }
+
+    /// The line of `swarm ctl list` about `robot`.
+    fn robot_line(&self, robot: u32) -> String {
+        let prefix = format!("robot {robot} ");
+        self.ctl(&["list"])
+            .lines()
+            .find(|l| l.starts_with(&prefix))
+            .unwrap_or_default()
+            .to_owned()
+    }
+
+    /// The launcher's next log line.
+    fn next_log_line(&mut self) -> String {
+        let mut line = String::new();
+        let read = self
+            .stderr
+            .read_line(&mut line)
+            .expect("the launcher's log");
+        assert!(read > 0, "the launcher ended early");
+        line
+    }
+
+    /// Interrupts the run, checks it ended cleanly and left nothing, and returns its summary.
+    fn stop(mut self) -> serde_json::Value {
+        let pid = self.child.id();
+        kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
+        let mut rest = String::new();
+        while self.stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
+        let status = self.child.wait().expect("the launcher exits");
+        assert!(status.success(), "{rest}");
+        assert_nothing_left(pid);
+        assert!(
+            !self.out.path().join("control.sock").exists(),
+            "the control socket is removed"
+        );
+        summary(self.out.path())
+    }
+}
+
+impl Drop for LiveRun {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+            remove_run_leftovers(&format!("sw{:x}-", self.child.id()));
+        }
+    }
+}
+
+fn fault_whats(summary: &serde_json::Value) -> Vec<String> {
+    faults(summary)
+        .iter()
+        .map(|f| f["what"].as_str().unwrap_or_default().to_owned())
+        .collect()
 }
 
 #[test]
 fn swarm_ctl_lists_freezes_thaws_and_kills_robots_of_a_live_run() {
-    let out = temp_dir();
-    let out_arg = out.path().display().to_string();
-    let mut child = spawn_swarm(&[
-        "run",
-        OBSTACLE_AVOIDANCE,
-        "--no-progress",
-        "--ticks",
-        "1000000",
-        "--tick-deadline-ms",
-        "100",
-        "--out",
-        out_arg.as_str(),
-    ]);
-    let pid = child.id();
-    let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
-    let mut line = String::new();
-    while stderr.read_line(&mut line).expect("the launcher's log") > 0
-        && !line.contains("first tick completed")
-    {
-        line.clear();
-    }
-    let list = ctl(out.path(), &["list"]);
+    let run = LiveRun::start(1_000_000, &[]);
+    let list = run.ctl(&["list"]);
     assert_eq!(
         list.lines()
             .filter(|l| l.ends_with("running restarts 0"))
@@ -417,33 +493,73 @@ fn swarm_ctl_lists_freezes_thaws_and_kills_robots_of_a_live_run() {
         ROBOTS,
         "{list}"
     );
-    assert_eq!(ctl(out.path(), &["freeze", "4"]), "robot 4 frozen\n");
+    assert_eq!(run.ctl(&["freeze", "4"]), "robot 4 frozen\n");
     assert!(
-        ctl(out.path(), &["list"]).contains("robot 4 fb"),
+        run.robot_line(4).starts_with("robot 4 fb"),
         "robots are listed by id"
     );
-    assert!(
-        ctl(out.path(), &["list"])
-            .lines()
-            .any(|l| l.starts_with("robot 4 ") && l.contains(" frozen "))
-    );
-    assert_eq!(ctl(out.path(), &["thaw", "4"]), "robot 4 thawed\n");
-    assert_eq!(ctl(out.path(), &["kill", "6"]), "robot 6 killed\n");
-    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
-    let mut rest = String::new();
-    while stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
-    let status = child.wait().expect("the launcher exits");
-    assert!(status.success(), "{rest}");
-    assert_nothing_left(pid);
-    let summary = summary(out.path());
-    let whats: Vec<String> = faults(&summary)
-        .iter()
-        .map(|f| f["what"].as_str().unwrap_or_default().to_owned())
-        .collect();
+    assert!(run.robot_line(4).contains(" frozen "));
+    assert_eq!(run.ctl(&["thaw", "4"]), "robot 4 thawed\n");
+    assert_eq!(run.ctl(&["kill", "6"]), "robot 6 killed\n");
+    let whats = fault_whats(&run.stop());
     assert!(whats.contains(&"ctl-freeze".to_owned()), "{whats:?}");
     assert!(whats.contains(&"ctl-thaw".to_owned()), "{whats:?}");
-    assert!(
-        !out.path().join("control.sock").exists(),
-        "the control socket is removed"
+    assert!(whats.contains(&"ctl-kill".to_owned()), "{whats:?}");
+}
+
+/// The process id `swarm ctl list` shows for `robot`.
+fn agent_pid(run: &LiveRun, robot: u32) -> i32 {
+    let line = run.robot_line(robot);
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = words
+        .iter()
+        .position(|w| *w == "pid")
+        .expect("a pid column");
+    words[at + 1].parse().expect("a process id")
+}
+
+#[test]
+fn an_agent_asked_to_stop_leaves_cleanly_and_only_always_restarts_it() {
+    // A bounded run: should the expected log lines never come, the launcher ends and the test fails.
+    let mut run = LiveRun::start(
+        20_000,
+        &[
+            "--fault",
+            "restart robots=3 policy=always backoff=0",
+            "--fault",
+            "restart robots=5 policy=on-failure backoff=0",
+        ],
     );
+    for robot in [3, 5] {
+        kill(Pid::from_raw(agent_pid(&run, robot)), Signal::SIGTERM).expect("SIGTERM the agent");
+    }
+    // Either order: the two agents leave at the same tick.
+    let (mut back, mut out) = (false, false);
+    while !(back && out) {
+        let line = run.next_log_line();
+        back |= line.contains("robot 3 takes part again");
+        out |= line.contains("robot 5 stays out of the run");
+    }
+    assert!(run.robot_line(3).ends_with("running restarts 1"));
+    assert!(run.robot_line(5).contains(" dead "));
+    let summary = run.stop();
+    let exits: Vec<serde_json::Value> = faults(&summary)
+        .into_iter()
+        .filter(|f| f["what"] == "exit")
+        .collect();
+    let exit_of = |robot: u64| {
+        exits
+            .iter()
+            .find(|f| f["robot"] == robot)
+            .unwrap_or_else(|| panic!("robot {robot}'s exit is logged: {exits:?}"))
+    };
+    for robot in [3, 5] {
+        assert_eq!(exit_of(robot)["status"], "exit status: 0", "a clean exit");
+    }
+    assert_eq!(
+        exit_of(3)["restarted"],
+        true,
+        "always restarts a clean exit"
+    );
+    assert_eq!(exit_of(5)["restarted"], false, "on-failure does not");
 }

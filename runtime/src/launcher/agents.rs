@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use super::children;
 use super::process_args::{AgentArgs, RunArgs};
-use super::restart::RestartTracker;
+use super::restart::{Ending, RestartTracker};
 use super::run_dir;
 use super::{LaunchError, io};
 
@@ -56,6 +56,8 @@ pub struct RobotEntry {
     pub open_fault: Option<usize>,
     /// When the launcher killed its agent outside the schedule, or first saw it gone (for latencies).
     pub gone_at: Option<Instant>,
+    /// How its last agent ended, for the restart policy (a failure unless it exited 0 before the run ended).
+    pub ending: Ending,
 }
 
 impl RobotEntry {
@@ -70,6 +72,7 @@ impl RobotEntry {
             ctl_killed: false,
             open_fault: None,
             gone_at: None,
+            ending: Ending::Failure,
         }
     }
 

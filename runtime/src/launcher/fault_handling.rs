@@ -5,6 +5,7 @@
 //! something takes effect. A scheduled kill is applied and reaped before the launcher answers `applied`, so
 //! the killed agent never produces a second, unscheduled death.
 
+use std::process::ExitStatus;
 use std::time::Instant;
 
 use nix::sys::signal::Signal;
@@ -114,8 +115,9 @@ impl Supervision {
             // Its agent still runs (frozen or late); the world takes it back when it answers again.
             return;
         }
-        let ending = Ending::Failure;
         let entry = &mut self.robots[robot as usize];
+        // A death the launcher did not see (a notice from elsewhere) counts as a failure.
+        let ending = std::mem::replace(&mut entry.ending, Ending::Failure);
         match entry.tracker.decide(ending, tick, self.ticks_per_second) {
             Some(Restart { attempt, delay, .. }) => {
                 entry.state = AgentState::Restarting;
@@ -128,6 +130,9 @@ impl Supervision {
                 self.pending_restarts.push((robot, Instant::now() + delay));
             }
             None => {
+                tracing::info!(
+                    "robot {robot} stays out of the run from tick {tick} (restart policy)"
+                );
                 entry.state = AgentState::Dead;
                 entry.open_fault = None;
                 entry.gone_at = None;
@@ -140,6 +145,7 @@ impl Supervision {
         let Some(entry) = self.robots.get_mut(robot as usize) else {
             return;
         };
+        tracing::info!("robot {robot} takes part again from tick {tick}");
         entry.state = AgentState::Running;
         let gone_at = entry.gone_at.take();
         if let Some(index) = entry.open_fault.take() {
@@ -156,9 +162,14 @@ impl Supervision {
     }
 
     /// An agent ended on its own (or by someone's signal): log it; the world's `down` decides the rest.
-    pub(super) fn on_exit(&mut self, robot: u32, status: String) {
+    pub(super) fn on_exit(&mut self, robot: u32, status: ExitStatus) {
         let entry = &mut self.robots[robot as usize];
         entry.gone_at = entry.gone_at.or(Some(Instant::now()));
+        entry.ending = if status.success() {
+            Ending::Success
+        } else {
+            Ending::Failure
+        };
         let what = if self.robots[robot as usize].ctl_killed {
             "ctl-kill"
         } else {
@@ -166,7 +177,7 @@ impl Supervision {
         };
         self.robots[robot as usize].ctl_killed = false;
         let index = self.log_fault(what, Some(robot), None);
-        self.faults[index].status = Some(status);
+        self.faults[index].status = Some(status.to_string());
         self.robots[robot as usize].open_fault = Some(index);
     }
 

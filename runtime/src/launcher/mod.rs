@@ -45,7 +45,7 @@ use nix::sys::signal::Signal;
 
 use crate::config::faults::{FaultKind, FaultSchedule};
 use crate::config::{ConfigErrors, Experiment};
-use crate::transport::RunSpec;
+use crate::transport::{self, RunSpec};
 use agents::{AgentSpawner, RobotEntry};
 use binaries::{Binaries, BinariesError};
 use children::Children;
@@ -327,6 +327,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         out_dir: out_dir.clone(),
         progress,
         started,
+        run: spec.clone(),
         first_tick: None,
         last_tick: 0,
         deaths: Vec::new(),
@@ -535,6 +536,8 @@ fn progress_bar(visible: bool, ticks: u64, robots: u32) -> ProgressBar {
 /// The launcher's view of a running experiment.
 struct Supervision {
     children: Children,
+    /// The run, to tell an agent that exits with it from one that exits before it.
+    run: RunSpec,
     world_stdin: Option<ChildStdin>,
     roster_ids: Vec<String>,
     out_dir: PathBuf,
@@ -648,18 +651,23 @@ impl Supervision {
                     log,
                 });
             }
-            if status.success() {
-                // Agents exit 0 only when the world has ended the run; the `finished` report may still be queued.
+            // Agents exit 0 when the world has ended the run (its `finished` report may still be queued), and
+            // when they are asked to stop (SIGTERM): that robot leaves the run, and only `always` restarts it.
+            if status.success() && (self.interrupted || transport::run_ended(&self.run)) {
                 continue;
             }
-            tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
+            if status.success() {
+                tracing::warn!(robot, tick = self.last_tick, "robot agent left the run");
+            } else {
+                tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
+            }
             self.send_world(world_control::WorldCommand::Dead(robot));
             self.deaths.push(Death {
                 robot,
                 after_tick: self.last_tick,
                 status: status.to_string(),
             });
-            self.on_exit(robot, status.to_string());
+            self.on_exit(robot, status);
         }
         Ok(())
     }

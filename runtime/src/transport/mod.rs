@@ -25,6 +25,12 @@ pub use run::RunSpec;
 pub use sync_block::MAX_ROBOTS;
 pub use world::{CommandStatus, DeathNotices, LinkConfig, TickOutcome, WorldLink};
 
+/// Whether the world has ended `run` (or its sync block is gone): an agent exiting now exits with the run, not
+/// before it.
+pub fn run_ended(run: &RunSpec) -> bool {
+    sync_block::SyncBlock::open(&run.sync_block_path()).map_or(true, |sync| sync.stopped())
+}
+
 /// What can go wrong in the local transport.
 #[derive(Debug, thiserror::Error)]
 pub enum TransportError {
