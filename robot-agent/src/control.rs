@@ -114,7 +114,8 @@ pub fn build(
         } => {
             let where_ = supervisors.to_string();
             let set = load_set(supervisors)?;
-            let callbacks = profiles::bind_profile(profile, params, &set.events)?;
+            let params = params.clone().with_run_seed(run_seed);
+            let callbacks = profiles::bind_profile(profile, &params, &set.events)?;
             info!(
                 profile = profile.as_str(),
                 supervisors = where_.as_str(),

@@ -31,10 +31,11 @@ pub enum ParamError {
     },
 }
 
-/// The attributes of a `<params>` element, in document order.
+/// The attributes of a `<params>` element, in document order, and the run's seed.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Params {
     entries: Vec<(String, String)>,
+    run_seed: u64,
 }
 
 impl Params {
@@ -50,7 +51,19 @@ impl Params {
                 .into_iter()
                 .map(|(k, v)| (k.into(), v.into()))
                 .collect(),
+            run_seed: 0,
         }
+    }
+
+    /// The same parameters in a run seeded with `seed` (for profiles whose defaults follow the run).
+    pub fn with_run_seed(mut self, seed: u64) -> Self {
+        self.run_seed = seed;
+        self
+    }
+
+    /// The run's seed (0 unless set with [`Params::with_run_seed`]).
+    pub fn run_seed(&self) -> u64 {
+        self.run_seed
     }
 
     /// The raw value of `name`, if given.

@@ -19,8 +19,9 @@
 //! each `sync`; flashes of several neighbours that overlap in that window count once. The camera never reports
 //! the robot's own LEDs.
 //!
-//! The counter starts at a value in [1, T] drawn from (`phase_seed`, robot index) on the robot's first tick: a
-//! profile is built before the robot's index is known to it, so the first frame supplies it. The plain-SCT
+//! The counter starts at a value in [1, T] drawn from (`phase_seed`, default the run seed; robot index) on the
+//! robot's first tick: a profile is built before the robot's index is known to it, so the first frame supplies
+//! it. The plain-SCT
 //! profile adds timer generators 1 (before `timeout`), 2 (before `sync`) and 3 (before `led_off`), each a one-step
 //! delay (`start_timer_x`, `timer_x_lw_1`, `inc_timer_x`, `timer_x_eq_1`, `end_timer_x`; see [`super::timer`]).
 
@@ -54,14 +55,15 @@ pub struct Firefly {
     pub alpha: f32,
     /// Ticks after a `sync` during which `saw_led` stays silent.
     pub refractory: u64,
-    /// Seed of the initial counter values.
+    /// Seed of the initial counter values (default: the run's seed).
     pub phase_seed: u64,
     counter: Option<u32>,
     last_sync: Option<u64>,
 }
 
 impl Firefly {
-    /// Reads `top` (whole, 1 to 2^32 - 1), `alpha` (in [0, 1]), `refractory` (whole ticks) and `phase_seed` (whole).
+    /// Reads `top` (whole, 1 to 2^32 - 1), `alpha` (in [0, 1]), `refractory` (whole ticks) and `phase_seed`
+    /// (whole; default the run's seed).
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
         let top = whole_or(params, "top", DEFAULT_TOP)?;
         if top == 0 {
@@ -75,7 +77,7 @@ impl Firefly {
             top,
             alpha: params.unit_f32_or("alpha", DEFAULT_ALPHA)?,
             refractory: whole_or(params, "refractory", DEFAULT_REFRACTORY)?,
-            phase_seed: whole_or(params, "phase_seed", 0)?,
+            phase_seed: whole_or(params, "phase_seed", params.run_seed())?,
             counter: None,
             last_sync: None,
         })
@@ -358,6 +360,14 @@ mod tests {
             values,
             "another phase_seed gives other phases"
         );
+    }
+
+    #[test]
+    fn phase_seed_defaults_to_the_run_seed_and_an_explicit_one_wins() {
+        let params = Params::default().with_run_seed(7);
+        assert_eq!(Firefly::from_params(&params).unwrap().phase_seed, 7);
+        let params = Params::new([("phase_seed", "11")]).with_run_seed(7);
+        assert_eq!(Firefly::from_params(&params).unwrap().phase_seed, 11);
     }
 
     #[test]

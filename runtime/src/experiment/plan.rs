@@ -316,7 +316,11 @@ mod tests {
             ("obstacle_avoidance/grid_small.toml", 2, vec![4, 8]),
             ("foraging/grid_reduced.toml", 16, vec![10, 20]),
             ("foraging/grid_thesis.toml", 480, vec![10, 20, 40, 70, 100]),
-            ("foraging/grid_thesis_5min.toml", 480, vec![10, 20, 40, 70, 100]),
+            (
+                "foraging/grid_thesis_5min.toml",
+                480,
+                vec![10, 20, 40, 70, 100],
+            ),
         ] {
             let grid = Grid::load(&configs.join(file)).unwrap_or_else(|e| panic!("{e}"));
             let configurations = configurations(&grid).unwrap_or_else(|e| panic!("{e}"));
