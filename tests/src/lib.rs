@@ -171,6 +171,22 @@ pub fn spawn_swarm(args: &[&str]) -> std::process::Child {
         .spawn()
         .expect("swarm starts")
 }
+/// Runs `swarm ctl <out> <request>` against a live run and returns its standard output (it must succeed).
+pub fn swarm_ctl(out: &Path, request: &[&str]) -> String {
+    let output = Command::new(bin_dir().join("swarm"))
+        .arg("ctl")
+        .arg(out)
+        .args(request)
+        .output()
+        .expect("swarm ctl runs");
+    assert!(
+        output.status.success(),
+        "swarm ctl {request:?} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
 /// Removes the shared-memory files and iceoryx2 root directories of every run whose name starts with `run_prefix`
 /// (for processes a test killed with SIGKILL, which cannot clean up themselves).
 pub fn remove_run_leftovers(run_prefix: &str) {
@@ -368,10 +384,16 @@ fn ip(args: &[&str]) -> Result<(), String> {
 }
 
 impl Netns {
-    /// Creates namespace number `index` (0-99) of this test process, or says why it cannot.
-    pub fn create(index: u32) -> Result<Netns, String> {
+    /// Creates a namespace of this test process (at most 100 per process), or says why it cannot. Tests run on
+    /// parallel threads of one process, so each namespace gets the next number of a process-wide counter.
+    pub fn create() -> Result<Netns, String> {
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
         if !is_root() {
             return Err("network namespaces need root".into());
+        }
+        let index = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if index >= 100 {
+            return Err("this test process already made 100 namespaces".into());
         }
         let tag = (std::process::id() % 10_000) * 100 + index;
         let subnet = (std::process::id() % 200) + 20;

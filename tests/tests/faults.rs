@@ -4,12 +4,12 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, ChildStderr, Command};
+use std::process::{Child, ChildStderr};
 
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
-    SwarmOutcome, assert_nothing_left, bin_dir, remove_run_leftovers, spawn_swarm, swarm,
+    SwarmOutcome, assert_nothing_left, remove_run_leftovers, spawn_swarm, swarm, swarm_ctl,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -413,18 +413,7 @@ impl LiveRun {
 
     /// Runs `swarm ctl <out> <request>` and returns its standard output.
     fn ctl(&self, request: &[&str]) -> String {
-        let output = Command::new(bin_dir().join("swarm"))
-            .arg("ctl")
-            .arg(self.out.path())
-            .args(request)
-            .output()
-            .expect("swarm ctl runs");
-        assert!(
-            output.status.success(),
-            "swarm ctl {request:?} failed: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        String::from_utf8_lossy(&output.stdout).into_owned()
+        swarm_ctl(self.out.path(), request)
     }
 
     /// The line of `swarm ctl list` about `robot`.

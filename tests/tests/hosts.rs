@@ -11,7 +11,7 @@ use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
     HostDaemon, Netns, assert_clean, bin_dir, follow_lines, free_port, shm_leftovers, swarm,
-    wait_for_line, workspace_root,
+    swarm_ctl, wait_for_line, workspace_root,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -30,7 +30,7 @@ struct Hosts {
 impl Hosts {
     fn start(names: &[&str]) -> Hosts {
         let namespaces: Result<Vec<Netns>, String> =
-            (0..names.len() as u32).map(Netns::create).collect();
+            names.iter().map(|_| Netns::create()).collect();
         match namespaces {
             Ok(namespaces) => {
                 let mut listen = Vec::new();
@@ -294,17 +294,19 @@ fn assert_lost_and_rejoined(out: &Path) {
     );
 }
 
-#[test]
-fn a_killed_host_is_lost_its_robots_die_and_a_restarted_one_rejoins() {
-    let mut hosts = Hosts::start(&["gamma", "delta"]);
+/// A run on hosts `names`; host 1 goes with `take_down` (given the hosts and the run directory) once it ticks, is
+/// restarted after the world noticed the loss, and rejoins; the records say so.
+fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Path)) {
+    let mut hosts = Hosts::start(names);
     let out = tempfile::tempdir().expect("a temporary directory");
     let mut run = BackgroundRun::start(out.path(), &hosts);
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
-        "host delta never ticked:\n{}",
+        "host {} never ticked:\n{}",
+        names[1],
         hosts.daemons[1].log()
     );
-    hosts.daemons[1].kill();
+    take_down(&mut hosts, out.path());
     run.wait_for("host lost");
     hosts.restart(1);
     run.wait_for("host rejoined");
@@ -316,6 +318,26 @@ fn a_killed_host_is_lost_its_robots_die_and_a_restarted_one_rejoins() {
     run.interrupt();
     assert_lost_and_rejoined(out.path());
     hosts.stop_and_check_clean();
+}
+
+#[test]
+fn a_killed_host_is_lost_its_robots_die_and_a_restarted_one_rejoins() {
+    lose_and_restart_host(&["gamma", "delta"], |hosts, _| hosts.daemons[1].kill());
+}
+
+#[test]
+fn a_host_killed_with_swarm_ctl_dies_is_lost_and_a_restarted_one_rejoins() {
+    lose_and_restart_host(&["eta", "theta"], |hosts, out| {
+        assert_eq!(
+            swarm_ctl(out, &["kill-host", "theta"]),
+            "host theta killed\n"
+        );
+        assert!(
+            hosts.daemons[1].wait_for("killed by `swarm ctl kill-host`", EVENT_TIMEOUT),
+            "the host did not die:\n{}",
+            hosts.daemons[1].log()
+        );
+    });
 }
 
 #[test]

@@ -4,7 +4,8 @@
 //! run directory (summary, trajectories, events, snapshot, logs). Ctrl-C stops the run cleanly: the world finishes
 //! its tick and flushes its records, and every process and shared-memory file of the run is removed.
 //! `swarm run --fault "kill robots=3 tick=50"` adds faults to the configuration's `<faults>`, and
-//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot>` drives a live run (docs/faults.md).
+//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot> | kill-host <host>` drives a live
+//! run (docs/faults.md).
 //!
 //! `swarm host --connect <endpoint>` runs one machine's share of multi-host runs (docs/hosts.md); `swarm run
 //! --hosts a,b` places a run's robots on such hosts.
@@ -122,6 +123,12 @@ enum CtlRequestArg {
     Thaw {
         /// Robot index.
         robot: u32,
+    },
+    /// Make a `swarm host` daemon of a multi-host run die, as if its machine failed: its robots are dead from
+    /// the tick the world notices.
+    KillHost {
+        /// Host name.
+        host: String,
     },
 }
 
@@ -312,9 +319,11 @@ fn ctl(run: &std::path::Path, request: CtlRequestArg) -> anyhow::Result<()> {
         CtlRequestArg::Kill { robot } => CtlCommand::Kill(robot),
         CtlRequestArg::Freeze { robot } => CtlCommand::Freeze(robot),
         CtlRequestArg::Thaw { robot } => CtlCommand::Thaw(robot),
+        CtlRequestArg::KillHost { host } => CtlCommand::KillHost(host),
     };
+    let shown = command.to_string();
     let answer = control::request(run, command)
-        .with_context(|| format!("swarm ctl {} {command}", run.display()))?;
+        .with_context(|| format!("swarm ctl {} {shown}", run.display()))?;
     print!("{answer}");
     Ok(())
 }

@@ -20,7 +20,7 @@ pub const CONTROL_SOCKET: &str = "control.sock";
 const REPLY_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// A request to the launcher of a live run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CtlCommand {
     /// Every robot with its agent's process id and state.
     List,
@@ -30,6 +30,8 @@ pub enum CtlCommand {
     Freeze(u32),
     /// SIGCONT the robot's agent.
     Thaw(u32),
+    /// Make the named `swarm host` daemon of a multi-host run die.
+    KillHost(String),
 }
 
 impl fmt::Display for CtlCommand {
@@ -39,6 +41,7 @@ impl fmt::Display for CtlCommand {
             CtlCommand::Kill(r) => write!(f, "kill {r}"),
             CtlCommand::Freeze(r) => write!(f, "freeze {r}"),
             CtlCommand::Thaw(r) => write!(f, "thaw {r}"),
+            CtlCommand::KillHost(host) => write!(f, "kill-host {host}"),
         }
     }
 }
@@ -56,8 +59,10 @@ impl CtlCommand {
             ["kill", r] => Ok(CtlCommand::Kill(robot(r)?)),
             ["freeze", r] => Ok(CtlCommand::Freeze(robot(r)?)),
             ["thaw", r] => Ok(CtlCommand::Thaw(robot(r)?)),
+            ["kill-host", host] => Ok(CtlCommand::KillHost((*host).to_owned())),
             _ => Err(format!(
-                "unknown request '{line}': use list, kill <robot>, freeze <robot> or thaw <robot>"
+                "unknown request '{line}': use list, kill <robot>, freeze <robot>, thaw <robot> or \
+                 kill-host <host>"
             )),
         }
     }

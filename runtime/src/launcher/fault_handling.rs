@@ -210,7 +210,7 @@ impl Supervision {
             None => return,
         };
         for request in requests {
-            let reply = self.control_request(request.command);
+            let reply = self.control_request(request.command.clone());
             request.answer(reply);
         }
     }
@@ -228,6 +228,9 @@ impl Supervision {
                 ));
             }
             return Ok(text);
+        }
+        if let CtlCommand::KillHost(host) = &command {
+            return self.kill_host(host);
         }
         let (CtlCommand::Kill(robot) | CtlCommand::Freeze(robot) | CtlCommand::Thaw(robot)) =
             command
@@ -332,6 +335,24 @@ impl Supervision {
     }
 
     /// SIGKILLs `robot`'s agent and reaps it, so its end is not seen again as an unscheduled death.
+    /// `swarm ctl kill-host`: the world tells the host to die; its loss is logged when the world notices it.
+    fn kill_host(&mut self, host: &str) -> Result<String, String> {
+        let Some(index) = self.host_names.iter().position(|h| h == host) else {
+            return Err(if self.host_names.is_empty() {
+                "this run has no hosts: its robots run on this machine".to_owned()
+            } else {
+                format!(
+                    "unknown host '{host}' (hosts: {})",
+                    self.host_names.join(", ")
+                )
+            });
+        };
+        self.send_world(WorldCommand::KillHost(index as u32));
+        let record = self.log_fault("ctl-kill-host", None, None);
+        self.faults[record].status = Some(format!("host {host}"));
+        Ok(format!("host {host} killed\n"))
+    }
+
     fn kill_and_reap(&mut self, robot: u32) {
         self.children.kill_agent(robot);
         self.robots[robot as usize].state = AgentState::Dead;

@@ -348,6 +348,11 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         faults: Vec::new(),
         pending_restarts: Vec::new(),
         reaped: Vec::new(),
+        host_names: placement
+            .iter()
+            .flatten()
+            .map(|share| share.name.clone())
+            .collect(),
         control,
     };
     if placement.is_none() {
@@ -556,6 +561,8 @@ struct Supervision {
     pending_restarts: Vec<(u32, Instant)>,
     /// Agents the launcher killed and reaped itself (`swarm ctl kill`), whose exit is still to be handled.
     reaped: Vec<(u32, ExitStatus)>,
+    /// The hosts of a multi-host run, in placement order (empty for a local run).
+    host_names: Vec<String>,
     control: Option<ControlServer>,
 }
 

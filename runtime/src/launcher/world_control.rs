@@ -2,7 +2,8 @@
 //!
 //! `dead 3` (the OS reported robot 3's agent gone), `rejoin 3 58` (robot 3's replacement takes part from tick
 //! 58: the world holds that tick until it has joined) and `applied 50` (every fault due at tick 50 is done: the
-//! world may open the tick). Plain text, so a person can drive a world by hand.
+//! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`). Plain
+//! text, so a person can drive a world by hand.
 
 use std::fmt;
 
@@ -20,6 +21,8 @@ pub enum WorldCommand {
     },
     /// The faults due at this tick are applied.
     Applied(u64),
+    /// Host with this index in the placement is to die.
+    KillHost(u32),
 }
 
 impl fmt::Display for WorldCommand {
@@ -28,6 +31,7 @@ impl fmt::Display for WorldCommand {
             WorldCommand::Dead(robot) => write!(f, "dead {robot}"),
             WorldCommand::Rejoin { robot, tick } => write!(f, "rejoin {robot} {tick}"),
             WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
+            WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
         }
     }
 }
@@ -43,6 +47,7 @@ impl WorldCommand {
                 tick: tick.parse().ok()?,
             }),
             ["applied", tick] => Some(WorldCommand::Applied(tick.parse().ok()?)),
+            ["kill-host", host] => Some(WorldCommand::KillHost(host.parse().ok()?)),
             _ => None,
         }
     }
@@ -58,6 +63,7 @@ mod tests {
             WorldCommand::Dead(3),
             WorldCommand::Rejoin { robot: 3, tick: 58 },
             WorldCommand::Applied(50),
+            WorldCommand::KillHost(1),
         ] {
             assert_eq!(WorldCommand::parse(&command.to_string()), Some(command));
         }

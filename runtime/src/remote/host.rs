@@ -68,6 +68,8 @@ enum Event {
     Frames { run: u64, bytes: Vec<u8> },
     /// The world of run `run` is gone.
     WorldGone { run: u64 },
+    /// The world of run `run` told the host to die.
+    Kill { run: u64 },
 }
 
 /// Counters of dropped messages, logged when a share ends.
@@ -102,6 +104,22 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
         })
         .wait()
         .map_err(zenoh_error("declaring the assignment queryable"))?;
+    let kill_sender = sender.clone();
+    let _kill: Subscriber<()> = session
+        .declare_subscriber(keys::kill(&options.name))
+        .callback(move |sample| {
+            let bytes = sample.payload().to_bytes();
+            match <[u8; 8]>::try_from(bytes.as_ref()) {
+                Ok(run) => {
+                    let _ = kill_sender.send(Event::Kill {
+                        run: u64::from_le_bytes(run),
+                    });
+                }
+                Err(_) => tracing::warn!(len = bytes.len(), "ignoring a malformed kill message"),
+            }
+        })
+        .wait()
+        .map_err(zenoh_error("subscribing to kill requests"))?;
     let _token: LivelinessToken = session
         .liveliness()
         .declare_token(keys::host_token(&options.name))
@@ -141,7 +159,18 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
                 tracing::info!(run = format!("{run:016x}"), "the world ended the run");
                 share = None;
             }
-            Some(Event::WorldGone { .. }) | None => {}
+            Some(Event::Kill { run })
+                if share.as_ref().is_some_and(|s| s.assignment.run == run) =>
+            {
+                // As if the machine died: the share ends and the daemon exits without a goodbye.
+                tracing::error!(
+                    run = format!("{run:016x}"),
+                    "killed by `swarm ctl kill-host`"
+                );
+                drop(share);
+                return Err(RemoteError::Killed { run });
+            }
+            Some(Event::WorldGone { .. } | Event::Kill { .. }) | None => {}
         }
         if let Some(current) = share.as_mut() {
             current.reap();

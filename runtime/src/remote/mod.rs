@@ -47,6 +47,12 @@ pub enum RemoteError {
         /// Its reason.
         reason: String,
     },
+    /// The world of the host's run told it to die (`swarm ctl kill-host`).
+    #[error("killed by `swarm ctl kill-host` in run {run:016x}")]
+    Killed {
+        /// The run.
+        run: u64,
+    },
     /// Hosts did not join in time.
     #[error("{0}")]
     HostsMissing(String),

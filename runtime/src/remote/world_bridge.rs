@@ -252,6 +252,22 @@ impl RemoteHosts {
         })
     }
 
+    /// Tells host `index` of the placement to die (`swarm ctl kill-host`); its loss is then noticed like any
+    /// other, through its liveliness token.
+    pub fn kill_host(&self, index: usize) -> Result<(), RemoteError> {
+        let Some(host) = self.hosts.get(index) else {
+            return Ok(());
+        };
+        tracing::warn!(host = host.share.name, "killing the host as asked");
+        self.session
+            .put(
+                keys::kill(&host.share.name),
+                self.run.to_le_bytes().to_vec(),
+            )
+            .wait()
+            .map_err(zenoh_error("telling a host to die"))
+    }
+
     /// Waits until every host of the placement announced itself and started its share (its agents joined).
     pub fn wait_for_hosts(&mut self, timeout: Duration) -> Result<(), RemoteError> {
         let deadline = Instant::now() + timeout;

@@ -80,8 +80,9 @@ pub struct FaultDriver {
 }
 
 /// Reads the launcher's lines on standard input: a death notice reaches the transport at once (so the current
-/// tick stops waiting), and every line goes to the main loop, which applies it between ticks.
-pub fn follow_launcher(notices: DeathNotices) -> Receiver<WorldCommand> {
+/// tick stops waiting; a run on hosts has no local transport: `None`), and every line goes to the main loop,
+/// which applies it between ticks.
+pub fn follow_launcher(notices: Option<DeathNotices>) -> Receiver<WorldCommand> {
     let (sender, receiver) = mpsc::channel();
     std::thread::spawn(move || {
         for line in std::io::stdin().lock().lines() {
@@ -90,7 +91,7 @@ pub fn follow_launcher(notices: DeathNotices) -> Receiver<WorldCommand> {
                 tracing::warn!("ignoring the launcher line '{line}'");
                 continue;
             };
-            if let WorldCommand::Dead(robot) = command
+            if let (WorldCommand::Dead(robot), Some(notices)) = (command, &notices)
                 && let Err(e) = notices.mark_dead(robot)
             {
                 tracing::warn!("ignoring death notice '{line}': {e}");
@@ -428,7 +429,7 @@ impl FaultDriver {
                 self.rejoin_at[robot as usize] = Some(tick);
             }
             WorldCommand::Applied(tick) => self.applied.push(tick),
-            other => tracing::warn!(?other, "ignoring a launcher line about an unknown robot"),
+            other => tracing::warn!(?other, "ignoring a launcher line that does not apply here"),
         }
     }
 

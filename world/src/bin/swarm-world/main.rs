@@ -102,10 +102,10 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
     // Local agents are supervised through the fault driver; hosts supervise their own agents.
-    let (mut link, mut faults) = match HostsPlan::resolve(&args.config, hosts)? {
+    let (mut link, mut faults, host_commands) = match HostsPlan::resolve(&args.config, hosts)? {
         None => {
             let link = WorldLink::create(&run, link_config)?;
-            let launcher = faults::follow_launcher(link.death_notices());
+            let launcher = faults::follow_launcher(Some(link.death_notices()));
             let driver = FaultDriver::new(
                 &link,
                 &schedule,
@@ -115,7 +115,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 args.out.clone(),
                 Duration::from_millis(args.join_timeout_ms),
             )?;
-            (Link::Local(link), Some(driver))
+            (Link::Local(link), Some(driver), None)
         }
         Some(plan) => {
             anyhow::ensure!(
@@ -125,7 +125,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             );
             let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
             let link = Link::remote(plan, args, controllers, link_config.tick_deadline)?;
-            (link, None)
+            (link, None, Some(faults::follow_launcher(None)))
         }
     };
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
@@ -158,7 +158,12 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             (Some(driver), Link::Local(local)) => {
                 driver.before_tick(local.tick() + 1, local, &mut world, &mut events, &commands)?;
             }
-            _ => link.apply_life_changes(&mut world),
+            _ => {
+                if let Some(commands) = &host_commands {
+                    link.apply_launcher_commands(commands)?;
+                }
+                link.apply_life_changes(&mut world);
+            }
         }
         let tick_started = Instant::now();
         let outcome = link.tick_with(|_, frames| world.sense(frames))?;

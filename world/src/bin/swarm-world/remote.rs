@@ -5,11 +5,13 @@
 //! world differently (the launcher's notices for local agents, the hosts' replies and liveliness for remote ones)
 //! and are applied to the world between ticks. A local run never opens a zenoh session.
 
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
 use swarm_runtime::launcher::hosts::HostsPlan;
 use swarm_runtime::launcher::process_args::WorldArgs;
+use swarm_runtime::launcher::world_control::WorldCommand;
 use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_runtime::remote::codec::DEFAULT_MAX_PAYLOAD;
 use swarm_runtime::remote::world_bridge::{HostEvent, RemoteHosts, RemoteOptions};
@@ -108,6 +110,26 @@ impl Link {
                 }
             }
         }
+    }
+
+    /// Carries out the launcher's lines that arrived so far in a run on hosts (`kill-host`); local runs take
+    /// theirs through the fault driver.
+    pub fn apply_launcher_commands(
+        &mut self,
+        commands: &Receiver<WorldCommand>,
+    ) -> anyhow::Result<()> {
+        let Link::Remote(hosts) = self else {
+            return Ok(());
+        };
+        while let Ok(command) = commands.try_recv() {
+            match command {
+                WorldCommand::KillHost(index) => hosts.kill_host(index as usize)?,
+                other => {
+                    tracing::warn!(?other, "ignoring a launcher line that does not apply here")
+                }
+            }
+        }
+        Ok(())
     }
 
     /// What happened to each host, for `summary.json` (`None` for a local run).
