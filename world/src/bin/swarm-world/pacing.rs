@@ -2,7 +2,9 @@
 //!
 //! Tick k (1-based) owns the slot ending at `start + k * period`. A tick that finishes early sleeps until its slot
 //! ends; a tick that finishes late is counted and the next slot is not shifted, so a late run shows its total lag
-//! instead of silently drifting.
+//! instead of silently drifting. Lateness can be inherited (slow first ticks push the following ones past their
+//! slots until the run catches up), so the pacer also counts the ticks whose own work took longer than a period,
+//! and the lag left at the last tick: none of those and no lag at the end means the run keeps up once going.
 
 use std::time::{Duration, Instant};
 
@@ -12,6 +14,9 @@ pub struct Pacer {
     start: Instant,
     ticks_late: u64,
     max_lag: Duration,
+    ticks_over_period: u64,
+    last_lag: Duration,
+    tick_started: Instant,
 }
 
 impl Pacer {
@@ -22,6 +27,9 @@ impl Pacer {
             start: Instant::now(),
             ticks_late: 0,
             max_lag: Duration::ZERO,
+            ticks_over_period: 0,
+            last_lag: Duration::ZERO,
+            tick_started: Instant::now(),
         }
     }
 
@@ -30,12 +38,17 @@ impl Pacer {
         let Some(period) = self.period else { return };
         let slot_end = self.start + period * u32::try_from(tick).unwrap_or(u32::MAX);
         let now = Instant::now();
+        if now - self.tick_started > period {
+            self.ticks_over_period += 1;
+        }
+        self.last_lag = now.saturating_duration_since(slot_end);
         if now <= slot_end {
             std::thread::sleep(slot_end - now);
         } else {
             self.ticks_late += 1;
             self.max_lag = self.max_lag.max(now - slot_end);
         }
+        self.tick_started = Instant::now();
     }
 
     /// What summary.json says about real-time mode (`null` when it was off).
@@ -46,6 +59,8 @@ impl Pacer {
                 "tick_period_ms": period.as_secs_f64() * 1e3,
                 "ticks_late": self.ticks_late,
                 "max_lag_ms": self.max_lag.as_secs_f64() * 1e3,
+                "ticks_over_period": self.ticks_over_period,
+                "lag_at_end_ms": self.last_lag.as_secs_f64() * 1e3,
                 "kept_up": ticks > 0 && self.ticks_late == 0,
             }),
         }
