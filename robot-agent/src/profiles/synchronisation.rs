@@ -194,18 +194,27 @@ impl AsMut<Firefly> for Synchronisation {
     }
 }
 
+/// The procedure table of a firefly profile (inside its `impl Profile`): the events both models share, then
+/// `extra` entries.
+macro_rules! firefly_procedures {
+    ($($extra:expr),* $(,)?) => {
+        &[
+            ("reached_top", Procedure::Check(reached_top::<Self>)),
+            ("saw_led", Procedure::Check(saw_led::<Self>)),
+            ("inc_counter", Procedure::Act(inc_counter::<Self>)),
+            ("timeout", Procedure::Act(timeout::<Self>)),
+            ("reset", Procedure::Act(reset::<Self>)),
+            ("led_on", Procedure::Act(led_on::<Self>)),
+            ("led_off", Procedure::Act(led_off::<Self>)),
+            ("sync", Procedure::Act(sync::<Self>)),
+            $($extra,)*
+        ]
+    };
+}
+
 impl Profile for Synchronisation {
     const NAME: &'static str = "synchronisation";
-    const PROCEDURES: &'static [(&'static str, Procedure<Self>)] = &[
-        ("reached_top", Procedure::Check(reached_top::<Self>)),
-        ("saw_led", Procedure::Check(saw_led::<Self>)),
-        ("inc_counter", Procedure::Act(inc_counter::<Self>)),
-        ("timeout", Procedure::Act(timeout::<Self>)),
-        ("reset", Procedure::Act(reset::<Self>)),
-        ("led_on", Procedure::Act(led_on::<Self>)),
-        ("led_off", Procedure::Act(led_off::<Self>)),
-        ("sync", Procedure::Act(sync::<Self>)),
-    ];
+    const PROCEDURES: &'static [(&'static str, Procedure<Self>)] = firefly_procedures!();
 
     fn from_params(params: &Params) -> Result<Self, ParamError> {
         Ok(Self {
@@ -261,15 +270,7 @@ fn timer_reached<const X: usize>(s: &SynchronisationSct, f: &SensorFrame) -> boo
 
 impl Profile for SynchronisationSct {
     const NAME: &'static str = "synchronisation_sct";
-    const PROCEDURES: &'static [(&'static str, Procedure<Self>)] = &[
-        ("reached_top", Procedure::Check(reached_top::<Self>)),
-        ("saw_led", Procedure::Check(saw_led::<Self>)),
-        ("inc_counter", Procedure::Act(inc_counter::<Self>)),
-        ("timeout", Procedure::Act(timeout::<Self>)),
-        ("reset", Procedure::Act(reset::<Self>)),
-        ("led_on", Procedure::Act(led_on::<Self>)),
-        ("led_off", Procedure::Act(led_off::<Self>)),
-        ("sync", Procedure::Act(sync::<Self>)),
+    const PROCEDURES: &'static [(&'static str, Procedure<Self>)] = firefly_procedures!(
         ("start_timer_1", Procedure::Act(start_timer::<0>)),
         ("timer_1_lw_1", Procedure::Check(timer_lower::<0>)),
         ("inc_timer_1", Procedure::Act(inc_timer::<0>)),
@@ -285,7 +286,7 @@ impl Profile for SynchronisationSct {
         ("inc_timer_3", Procedure::Act(inc_timer::<2>)),
         ("timer_3_eq_1", Procedure::Check(timer_reached::<2>)),
         ("end_timer_3", Procedure::Act(end_timer::<2>)),
-    ];
+    );
 
     fn from_params(params: &Params) -> Result<Self, ParamError> {
         Ok(Self {

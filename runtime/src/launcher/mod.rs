@@ -638,8 +638,8 @@ impl Supervision {
         }
     }
 
-    /// Reaps exited agents: before the first tick an exit is a failed start; afterwards an unsuccessful exit is a
-    /// death the world hears of at once (a successful one means the world already ended the run).
+    /// Reaps exited agents (and takes those `swarm ctl kill` reaped): before the first tick an exit is a failed
+    /// start; afterwards an exit is a death the world hears of at once, unless the agent exited 0 with the run.
     fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
         let mut exits = std::mem::take(&mut self.reaped);
         exits.extend(self.children.reap_agents());

@@ -64,11 +64,7 @@ impl<'a> ParamReader<'a> {
         ok: fn(f64) -> bool,
         expected: &str,
     ) -> Result<f64, WorldError> {
-        let Some(raw) = self
-            .params
-            .attributes
-            .get(&format!("{}.{name}", self.element))
-        else {
+        let Some(raw) = self.raw(name) else {
             return Ok(default);
         };
         match raw.trim().parse::<f64>() {
@@ -79,17 +75,20 @@ impl<'a> ParamReader<'a> {
 
     /// Attribute `name` as a whole number >= `min`, or `default` when absent.
     pub fn u64_at_least(&self, name: &str, default: u64, min: u64) -> Result<u64, WorldError> {
-        let Some(raw) = self
-            .params
-            .attributes
-            .get(&format!("{}.{name}", self.element))
-        else {
+        let Some(raw) = self.raw(name) else {
             return Ok(default);
         };
         match raw.trim().parse::<u64>() {
             Ok(v) if v >= min => Ok(v),
             _ => Err(self.invalid(name, raw, &format!("a whole number >= {min}"))),
         }
+    }
+
+    /// The text of attribute `name` of this element, if given.
+    fn raw(&self, name: &str) -> Option<&String> {
+        self.params
+            .attributes
+            .get(&format!("{}.{name}", self.element))
     }
 
     fn invalid(&self, name: &str, raw: &str, expected: &str) -> WorldError {
