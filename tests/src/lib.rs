@@ -10,15 +10,16 @@ use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 /// The folder holding `swarm`, `swarm-world` and `robot-agent`, brought up to date once per test binary with the
-/// cargo that runs the tests. `--workspace --tests` selects the same packages and features as
-/// `cargo test --workspace`, which has already built these programs, so under the README's test command this is
-/// a no-op; run alone (`cargo test -p swarm-system-tests`) it builds what is missing.
+/// cargo that runs the tests. It asks for exactly the build of the README's test command (`cargo test --workspace`,
+/// without running anything), so under that command this is a no-op; run alone (`cargo test -p
+/// swarm-system-tests`) it builds what is missing. (`cargo build --workspace --tests` would resolve dependency
+/// features differently and build zenoh's TLS stack a second time.)
 pub fn bin_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let status = Command::new(cargo)
-            .args(["build", "--quiet", "--workspace", "--tests"])
+            .args(["test", "--quiet", "--workspace", "--no-run"])
             .current_dir(workspace_root())
             .status()
             .expect("cargo must be runnable from the tests");
@@ -229,6 +230,16 @@ pub struct HostDaemon {
 impl HostDaemon {
     /// Starts `swarm host --connect <connect> --name <name>`, inside `netns` when given.
     pub fn start(name: &str, connect: &str, netns: Option<&str>) -> HostDaemon {
+        HostDaemon::start_with(name, connect, netns, &[])
+    }
+
+    /// Like [`HostDaemon::start`], with more `swarm host` flags (e.g. credentials).
+    pub fn start_with(
+        name: &str,
+        connect: &str,
+        netns: Option<&str>,
+        flags: &[&std::ffi::OsStr],
+    ) -> HostDaemon {
         let dir = bin_dir();
         let logs = tempfile::tempdir().expect("a temporary directory");
         let swarm = dir.join("swarm");
@@ -243,6 +254,7 @@ impl HostDaemon {
         command
             .args(["host", "--connect", connect, "--name", name, "--logs"])
             .arg(logs.path())
+            .args(flags)
             .env("SWARM_BIN_DIR", dir)
             .env("RUST_LOG", "info,zenoh=warn")
             .current_dir(workspace_root())

@@ -29,7 +29,7 @@ use swarm_runtime::launcher::hosts::HostsArgs;
 use swarm_runtime::launcher::{self, RunOptions};
 use swarm_runtime::remote::codec::DEFAULT_MAX_PAYLOAD;
 use swarm_runtime::remote::host::{self, HostOptions};
-use swarm_runtime::remote::session::{DEFAULT_LEASE, ZenohOptions};
+use swarm_runtime::remote::session::{DEFAULT_LEASE, TlsFiles, ZenohOptions};
 
 /// Runs swarms of robot processes executing ptSCT supervisors.
 #[derive(Debug, Parser)]
@@ -60,6 +60,9 @@ enum Commands {
         /// Milliseconds a tick waits for a missing command before it goes on without it.
         #[arg(long = "tick-deadline-ms")]
         tick_deadline_ms: Option<u64>,
+        /// Milliseconds the run waits for its robots (or hosts) to join before it gives up (default 120000).
+        #[arg(long = "join-timeout-ms")]
+        join_timeout_ms: Option<u64>,
         /// Do not draw a progress bar.
         #[arg(long)]
         no_progress: bool,
@@ -188,6 +191,15 @@ struct HostCli {
     /// File holding the zenoh password.
     #[arg(long = "password-file", requires = "user")]
     password_file: Option<PathBuf>,
+    /// For a tls/... endpoint: the PEM certificate authority the world's certificate must be signed by.
+    #[arg(long = "tls-root-ca")]
+    tls_root_ca: Option<PathBuf>,
+    /// For mutual TLS: this host's PEM certificate (with --tls-private-key).
+    #[arg(long = "tls-certificate", requires = "tls_private_key")]
+    tls_certificate: Option<PathBuf>,
+    /// For mutual TLS: this host's PEM private key (with --tls-certificate).
+    #[arg(long = "tls-private-key", requires = "tls_certificate")]
+    tls_private_key: Option<PathBuf>,
     /// Folder for the agents' logs (default: <temp>/swarm-host-<name>).
     #[arg(long)]
     logs: Option<PathBuf>,
@@ -260,6 +272,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seed,
             out,
             tick_deadline_ms,
+            join_timeout_ms,
             no_progress,
             real_time,
             faults,
@@ -277,6 +290,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 out,
                 progress: !no_progress,
                 tick_deadline: tick_deadline_ms.map(Duration::from_millis),
+                join_timeout: join_timeout_ms.map(Duration::from_millis),
                 real_time,
                 faults,
                 hosts,
@@ -355,6 +369,12 @@ fn run_host(cli: HostCli) -> anyhow::Result<()> {
         ),
         None => None,
     };
+    let tls = TlsFiles {
+        root_ca: cli.tls_root_ca,
+        certificate: cli.tls_certificate,
+        private_key: cli.tls_private_key,
+    };
+    tls.check_readable()?;
     let logs = cli
         .logs
         .unwrap_or_else(|| std::env::temp_dir().join(format!("swarm-host-{name}")));
@@ -367,6 +387,7 @@ fn run_host(cli: HostCli) -> anyhow::Result<()> {
             user: cli.user,
             password,
             credentials_file: None,
+            tls,
         },
         max_payload: DEFAULT_MAX_PAYLOAD,
         logs,

@@ -9,8 +9,10 @@
 //!
 //! Attributes of `<hosts>`: `listen` (comma-separated zenoh endpoints the world listens on, default loopback),
 //! `lease_ms` (how fast a frozen or cut-off host is noticed, default 1000), `zenoh_config` (a zenoh JSON5
-//! configuration file to start from), `user` and `password_file` (zenoh user/password authentication) and
-//! `credentials_file` (the `user:password` lines the world accepts). Paths are relative to the experiment file.
+//! configuration file to start from), `user` and `password_file` (zenoh user/password authentication),
+//! `credentials_file` (the `user:password` lines the world accepts), and for `tls/...` endpoints
+//! `tls_certificate` and `tls_private_key` (the world's PEM certificate and key) and `tls_root_ca` (mutual TLS: hosts
+//! must present a certificate signed by this authority). Paths are relative to the experiment file.
 //! Each `<host>` has a `name` (as given to `swarm host --name`) and an optional integer `weight` (default 1):
 //! robots are shared in proportion to the weights. Without `<hosts>` every robot runs on the launcher's machine.
 //!
@@ -23,6 +25,7 @@ use super::diagnostic::{ConfigErrors, Diagnostic};
 use super::model::{Element, Location};
 use super::xml::parse_tree;
 use crate::remote::keys::check_host_name;
+use crate::remote::session::TlsFiles;
 
 /// One `<host>`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -50,6 +53,8 @@ pub struct HostsConfig {
     pub password_file: Option<PathBuf>,
     /// File of `user:password` lines the world accepts.
     pub credentials_file: Option<PathBuf>,
+    /// The world's TLS certificate and key, and the authority hosts' certificates must be signed by.
+    pub tls: TlsFiles,
     /// The hosts, in file order.
     pub hosts: Vec<HostEntry>,
     /// Where the element is.
@@ -63,6 +68,9 @@ const ATTRIBUTES: &[&str] = &[
     "user",
     "password_file",
     "credentials_file",
+    "tls_certificate",
+    "tls_private_key",
+    "tls_root_ca",
 ];
 
 impl HostsConfig {
@@ -154,6 +162,22 @@ pub(crate) fn parse(el: &Element, base: &Path) -> (Option<HostsConfig>, Vec<(Loc
                 .into(),
         ));
     }
+    if text("tls_certificate").is_some() != text("tls_private_key").is_some() {
+        errors.push((
+            el.location,
+            "<hosts> needs both 'tls_certificate' and 'tls_private_key' for TLS, or neither".into(),
+        ));
+    }
+    if let Some((_, at)) = text("tls_root_ca")
+        && text("tls_certificate").is_none()
+    {
+        errors.push((
+            at,
+            "'tls_root_ca' in <hosts> asks hosts for certificates (mutual TLS), which needs the world's own \
+             'tls_certificate' and 'tls_private_key'"
+                .into(),
+        ));
+    }
     let mut hosts: Vec<HostEntry> = Vec::new();
     for child in &el.children {
         if child.name != "host" {
@@ -190,6 +214,11 @@ pub(crate) fn parse(el: &Element, base: &Path) -> (Option<HostsConfig>, Vec<(Loc
         user: text("user").map(|(v, _)| v.to_owned()),
         password_file: path("password_file"),
         credentials_file: path("credentials_file"),
+        tls: TlsFiles {
+            root_ca: path("tls_root_ca"),
+            certificate: path("tls_certificate"),
+            private_key: path("tls_private_key"),
+        },
         hosts,
         location: el.location,
     };
@@ -297,6 +326,52 @@ mod tests {
         assert!(text.contains(":6:16: 'weight' in <host> must be"), "{text}");
         assert!(
             text.contains(":7:18: host 'd' appears twice in <hosts> (first at 7:1)"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn tls_files_are_relative_to_the_experiment() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let path = dir.path().join("x.argos");
+        std::fs::write(
+            &path,
+            experiment(
+                r#"<hosts listen="tls/10.0.0.1:7447" tls_certificate="pki/world.pem" tls_private_key="pki/world.key" tls_root_ca="pki/ca.pem"><host name="a" /></hosts>"#,
+            ),
+        )
+        .expect("write");
+        let config = HostsConfig::load(&path).expect("valid").expect("present");
+        assert_eq!(
+            config.tls,
+            TlsFiles {
+                root_ca: Some(dir.path().join("pki/ca.pem")),
+                certificate: Some(dir.path().join("pki/world.pem")),
+                private_key: Some(dir.path().join("pki/world.key")),
+            }
+        );
+    }
+
+    #[test]
+    fn incomplete_tls_settings_are_located_errors() {
+        let errors = load(&experiment(
+            "<hosts tls_certificate=\"w.pem\">\n<host name=\"a\" /></hosts>",
+        ))
+        .expect_err("invalid");
+        let text = errors.to_string();
+        assert!(
+            text.contains(":4:1: <hosts> needs both 'tls_certificate' and 'tls_private_key'"),
+            "{text}"
+        );
+        let errors = load(&experiment(
+            "<hosts tls_root_ca=\"ca.pem\"><host name=\"a\" /></hosts>",
+        ))
+        .expect_err("invalid");
+        let text = errors.to_string();
+        assert!(
+            text.contains(
+                ":4:8: 'tls_root_ca' in <hosts> asks hosts for certificates (mutual TLS)"
+            ),
             "{text}"
         );
     }

@@ -13,7 +13,7 @@ use clap::Args;
 use crate::config::ConfigErrors;
 use crate::config::hosts::HostsConfig;
 use crate::remote::keys::check_host_name;
-use crate::remote::session::{DEFAULT_LEASE, DEFAULT_LISTEN, ZenohOptions};
+use crate::remote::session::{DEFAULT_LEASE, DEFAULT_LISTEN, TlsFileError, ZenohOptions};
 use crate::remote::world_bridge::HostShare;
 
 /// Flags of `swarm run` and of the world process that place robots on hosts.
@@ -65,6 +65,17 @@ pub enum HostsError {
         /// The cause.
         #[source]
         source: std::io::Error,
+    },
+    /// A TLS file cannot be read.
+    #[error("{0}")]
+    TlsFile(#[from] TlsFileError),
+    /// The world is to listen on a `tls/...` endpoint without a certificate.
+    #[error(
+        "the world listens on {endpoint}, which needs the experiment's <hosts tls_certificate=\"…\" tls_private_key=\"…\">"
+    )]
+    TlsWithoutCertificate {
+        /// The endpoint.
+        endpoint: String,
     },
 }
 
@@ -161,12 +172,21 @@ impl HostsPlan {
             zenoh.config_file = element.zenoh_config;
             zenoh.user = element.user;
             zenoh.credentials_file = element.credentials_file;
+            zenoh.tls = element.tls;
             if let Some(path) = element.password_file {
                 let text = std::fs::read_to_string(&path)
                     .map_err(|source| HostsError::Password { path, source })?;
                 zenoh.password = Some(text.trim_end_matches(['\r', '\n']).to_owned());
             }
         }
+        if let Some(endpoint) = listen.iter().find(|e| e.starts_with("tls/"))
+            && zenoh.tls.certificate.is_none()
+        {
+            return Err(HostsError::TlsWithoutCertificate {
+                endpoint: endpoint.clone(),
+            });
+        }
+        zenoh.tls.check_readable()?;
         Ok(Some(HostsPlan {
             hosts,
             listen,
@@ -316,5 +336,37 @@ mod tests {
             let err = parse_hosts_flag(flag).expect_err(flag).to_string();
             assert!(err.contains(expected), "{flag}: {err}");
         }
+    }
+
+    #[test]
+    fn tls_endpoints_need_a_readable_certificate() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let plain = experiment(dir.path(), r#"<hosts><host name="a" /></hosts>"#);
+        let args = HostsArgs {
+            hosts: None,
+            listen: vec!["tls/127.0.0.1:9000".into()],
+        };
+        let err = HostsPlan::resolve(&plain, &args)
+            .expect_err("no certificate")
+            .to_string();
+        assert!(
+            err.contains("the world listens on tls/127.0.0.1:9000, which needs"),
+            "{err}"
+        );
+
+        let missing = experiment(
+            dir.path(),
+            r#"<hosts listen="tls/127.0.0.1:9000" tls_certificate="w.pem" tls_private_key="w.key"><host name="a" /></hosts>"#,
+        );
+        let err = HostsPlan::resolve(&missing, &HostsArgs::default())
+            .expect_err("missing files")
+            .to_string();
+        assert!(
+            err.contains(&format!(
+                "cannot read the TLS certificate {}",
+                dir.path().join("w.pem").display()
+            )),
+            "{err}"
+        );
     }
 }

@@ -65,6 +65,9 @@ const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
 /// Lines of an agent's log quoted when it fails to start.
 const LOG_LINES_QUOTED: usize = 8;
 
+/// How long a run waits for its agents, or its hosts, to join before it gives up.
+pub const DEFAULT_JOIN_TIMEOUT: Duration = Duration::from_secs(120);
+
 /// What `swarm run` was asked to do.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
@@ -82,6 +85,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// How long a tick waits for a missing command (default: the transport's).
     pub tick_deadline: Option<Duration>,
+    /// How long the run waits for its agents or hosts to join (default [`DEFAULT_JOIN_TIMEOUT`]).
+    pub join_timeout: Option<Duration>,
     /// Pace the ticks at the configuration's ticks_per_second (real-time mode) instead of running flat out.
     pub real_time: bool,
     /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
@@ -276,7 +281,10 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         robots: options.robots,
         out: out_dir.clone(),
         tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
-        join_timeout_ms: 120_000,
+        join_timeout_ms: options
+            .join_timeout
+            .unwrap_or(DEFAULT_JOIN_TIMEOUT)
+            .as_millis() as u64,
         real_time: options.real_time,
         faults: options.faults.clone(),
     };

@@ -5,8 +5,8 @@
 //! peer mode and listens (loopback by default); hosts run in client mode and connect to one of its endpoints,
 //! retrying every second while it is unreachable (so a host whose network came back rejoins by itself). The link
 //! lease decides how fast a frozen or cut-off host is noticed (default 1 s; a killed one is noticed in
-//! milliseconds, when its TCP connection closes). A zenoh configuration file can supply anything else (e.g. TLS
-//! when zenoh is built with `transport_tls`); user/password authentication is set here.
+//! milliseconds, when its TCP connection closes). User/password authentication and TLS certificates are set
+//! here; a zenoh configuration file can supply anything else.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -33,6 +33,61 @@ pub struct ZenohOptions {
     pub password: Option<String>,
     /// File of `user:password` lines the listening side accepts (zenoh's `dictionary_file`).
     pub credentials_file: Option<PathBuf>,
+    /// Certificates for `tls/...` endpoints.
+    pub tls: TlsFiles,
+}
+
+/// The PEM files of a TLS link. On the listening side (the world) `certificate` and `private_key` identify the
+/// world, and `root_ca` turns on mutual TLS: every host must present a certificate signed by it. On the
+/// connecting side (a host) `root_ca` is what the world's certificate must be signed by, and `certificate` and
+/// `private_key` identify the host for mutual TLS.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct TlsFiles {
+    /// Certificate authority the other side's certificate must be signed by.
+    pub root_ca: Option<PathBuf>,
+    /// This side's certificate chain.
+    pub certificate: Option<PathBuf>,
+    /// This side's private key.
+    pub private_key: Option<PathBuf>,
+}
+
+/// A TLS file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read the TLS {role} {path}: {source}")]
+pub struct TlsFileError {
+    /// What the file is for (e.g. "certificate").
+    pub role: &'static str,
+    /// The file.
+    pub path: PathBuf,
+    /// The cause.
+    #[source]
+    pub source: std::io::Error,
+}
+
+impl TlsFiles {
+    /// Whether any file is set.
+    pub fn is_set(&self) -> bool {
+        self.root_ca.is_some() || self.certificate.is_some() || self.private_key.is_some()
+    }
+
+    /// Checks that every file set can be read, so a wrong path is reported by name before zenoh starts.
+    pub fn check_readable(&self) -> Result<(), TlsFileError> {
+        let files = [
+            ("root certificate authority", &self.root_ca),
+            ("certificate", &self.certificate),
+            ("private key", &self.private_key),
+        ];
+        for (role, path) in files {
+            if let Some(path) = path {
+                std::fs::File::open(path).map_err(|source| TlsFileError {
+                    role,
+                    path: path.clone(),
+                    source,
+                })?;
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Default for ZenohOptions {
@@ -43,6 +98,7 @@ impl Default for ZenohOptions {
             user: None,
             password: None,
             credentials_file: None,
+            tls: TlsFiles::default(),
         }
     }
 }
@@ -61,9 +117,30 @@ fn json(s: &str) -> String {
     serde_json::Value::String(s.to_owned()).to_string()
 }
 
+/// A path as a JSON string literal.
+fn json_path(path: &std::path::Path) -> String {
+    json(&path.display().to_string())
+}
+
+/// Sets one key of a zenoh configuration, saying which on failure.
+fn set(config: &mut Config, key: &str, value: &str) -> Result<(), RemoteError> {
+    config
+        .insert_json5(key, value)
+        .map_err(zenoh_error(format!("setting zenoh's {key} to {value}")))
+}
+
+/// Which end of a link the TLS files are for.
+#[derive(Clone, Copy)]
+enum TlsSide {
+    Listen,
+    Connect,
+}
+
+const TLS: &str = "transport/link/tls";
+
 impl ZenohOptions {
     /// The zenoh configuration for `mode` with our common settings.
-    fn config(&self, mode: &str) -> Result<Config, RemoteError> {
+    fn config(&self, mode: &str, side: TlsSide) -> Result<Config, RemoteError> {
         let mut config = match &self.config_file {
             Some(path) => Config::from_file(path).map_err(zenoh_error(format!(
                 "reading the zenoh configuration {}",
@@ -72,36 +149,73 @@ impl ZenohOptions {
             None => Config::default(),
         };
         let lease_ms = self.lease.as_millis().max(1);
-        let mut set = |key: &str, value: String| {
-            config
-                .insert_json5(key, &value)
-                .map_err(zenoh_error(format!("setting zenoh's {key} to {value}")))
-        };
-        set("mode", json(mode))?;
-        set("scouting/multicast/enabled", "false".into())?;
-        set("transport/link/tx/lease", lease_ms.to_string())?;
+        set(&mut config, "mode", &json(mode))?;
+        set(&mut config, "scouting/multicast/enabled", "false")?;
         set(
+            &mut config,
+            "transport/link/tx/lease",
+            &lease_ms.to_string(),
+        )?;
+        set(
+            &mut config,
             "connect/retry",
-            r#"{"period_init_ms": 250, "period_max_ms": 1000, "period_increase_factor": 2}"#.into(),
+            r#"{"period_init_ms": 250, "period_max_ms": 1000, "period_increase_factor": 2}"#,
         )?;
         if let Some(user) = &self.user {
-            set("transport/auth/usrpwd/user", json(user))?;
+            set(&mut config, "transport/auth/usrpwd/user", &json(user))?;
         }
         if let Some(password) = &self.password {
-            set("transport/auth/usrpwd/password", json(password))?;
+            set(
+                &mut config,
+                "transport/auth/usrpwd/password",
+                &json(password),
+            )?;
         }
         if let Some(file) = &self.credentials_file {
             set(
+                &mut config,
                 "transport/auth/usrpwd/dictionary_file",
-                json(&file.display().to_string()),
+                &json_path(file),
             )?;
         }
+        self.set_tls(&mut config, side)?;
         Ok(config)
+    }
+
+    /// The TLS files as zenoh's `transport/link/tls` settings for one end of the link.
+    fn set_tls(&self, config: &mut Config, side: TlsSide) -> Result<(), RemoteError> {
+        let tls = &self.tls;
+        let (certificate, private_key) = match side {
+            TlsSide::Listen => ("listen_certificate", "listen_private_key"),
+            TlsSide::Connect => ("connect_certificate", "connect_private_key"),
+        };
+        // zenoh asks for (listening) or presents (connecting) a client certificate only with `enable_mtls`.
+        let mutual = match side {
+            TlsSide::Listen => tls.root_ca.is_some(),
+            TlsSide::Connect => tls.certificate.is_some(),
+        };
+        if mutual {
+            set(config, &format!("{TLS}/enable_mtls"), "true")?;
+        }
+        if let Some(path) = &tls.root_ca {
+            set(
+                config,
+                &format!("{TLS}/root_ca_certificate"),
+                &json_path(path),
+            )?;
+        }
+        if let Some(path) = &tls.certificate {
+            set(config, &format!("{TLS}/{certificate}"), &json_path(path))?;
+        }
+        if let Some(path) = &tls.private_key {
+            set(config, &format!("{TLS}/{private_key}"), &json_path(path))?;
+        }
+        Ok(())
     }
 
     /// The world's session: peer mode, listening on `listen` (e.g. `tcp/127.0.0.1:7447`).
     pub fn open_world(&self, listen: &[String]) -> Result<Session, RemoteError> {
-        let mut config = self.config("peer")?;
+        let mut config = self.config("peer", TlsSide::Listen)?;
         let endpoints = serde_json::to_string(listen).unwrap_or_else(|_| "[]".into());
         config
             .insert_json5("listen/endpoints", &endpoints)
@@ -116,17 +230,12 @@ impl ZenohOptions {
 
     /// A host's session: client mode, connected to `endpoint` (retried until it answers).
     pub fn open_host(&self, endpoint: &str) -> Result<Session, RemoteError> {
-        let mut config = self.config("client")?;
+        let mut config = self.config("client", TlsSide::Connect)?;
         let endpoints = serde_json::to_string(&[endpoint]).unwrap_or_else(|_| "[]".into());
-        let mut set = |key: &str, value: &str| {
-            config
-                .insert_json5(key, value)
-                .map_err(zenoh_error(format!("setting zenoh's {key} to {value}")))
-        };
-        set("connect/endpoints", &endpoints)?;
-        set("listen/endpoints", "[]")?;
-        set("connect/timeout_ms", "-1")?;
-        set("connect/exit_on_failure", "false")?;
+        set(&mut config, "connect/endpoints", &endpoints)?;
+        set(&mut config, "listen/endpoints", "[]")?;
+        set(&mut config, "connect/timeout_ms", "-1")?;
+        set(&mut config, "connect/exit_on_failure", "false")?;
         zenoh::open(config)
             .wait()
             .map_err(zenoh_error(format!("connecting to {endpoint}")))
