@@ -224,7 +224,7 @@ pub struct HostDaemon {
     seen: Vec<String>,
     /// The host name.
     pub name: String,
-    _logs: tempfile::TempDir,
+    logs: tempfile::TempDir,
 }
 
 impl HostDaemon {
@@ -268,7 +268,7 @@ impl HostDaemon {
             lines,
             seen: Vec::new(),
             name: name.to_owned(),
-            _logs: logs,
+            logs,
         }
     }
 
@@ -286,6 +286,12 @@ impl HostDaemon {
     /// Every log line read so far.
     pub fn log(&self) -> String {
         self.seen.join("\n")
+    }
+
+    /// The log of the agent this daemon started last for run-wide robot `robot` (empty when there is none).
+    pub fn agent_log(&self, robot: u64) -> String {
+        std::fs::read_to_string(self.logs.path().join(format!("robot-{robot}.log")))
+            .unwrap_or_default()
     }
 
     /// Asks the daemon to stop (SIGTERM) and waits for it; true when it exited successfully.

@@ -259,8 +259,10 @@ fn alive_over_time(out: &Path, robot: usize, robots: usize) -> Vec<(u64, bool)> 
 
 /// Checks the summary recorded one loss and one return of host 1 and that its first robot died and came back at
 /// those ticks while host 0's robots lived throughout. The world applies a decision between ticks, so the record
-/// shows a robot dead from the tick after the loss and alive from the tick after its host's first answer.
-fn assert_lost_and_rejoined(out: &Path) {
+/// shows a robot dead from the tick after the loss and alive from the tick after its host's first answer. The
+/// robot's fresh agent on the rejoined host must have resumed its supervisors at a world tick after the loss, from
+/// the world's last record before it.
+fn assert_lost_and_rejoined(out: &Path, rejoined: &HostDaemon) {
     let summary = summary(out);
     let host = &summary["hosts"]["hosts"][1];
     let lost: Vec<u64> = serde_json::from_value(host["lost_at_ticks"].clone()).expect("lost ticks");
@@ -275,6 +277,7 @@ fn assert_lost_and_rejoined(out: &Path) {
         back[0]
     );
     let robot = host["robots"][0].as_u64().expect("a robot id") as usize;
+    assert_resumed_after(&rejoined.agent_log(robot as u64), lost[0]);
     for (tick, alive) in alive_over_time(out, robot, RUN_ROBOTS) {
         let expected = tick <= lost[0] || tick > back[0];
         assert_eq!(
@@ -292,6 +295,34 @@ fn assert_lost_and_rejoined(out: &Path) {
             .all(|(_, alive)| *alive),
         "host 0's robots lived throughout"
     );
+}
+
+/// Checks an agent's log says it resumed its supervisors at a tick after `lost`, from a snapshot recorded before.
+fn assert_resumed_after(log: &str, lost: u64) {
+    let line = log
+        .lines()
+        .find(|l| l.contains("resumed supervisors at tick "))
+        .unwrap_or_else(|| panic!("the rejoined robot's agent did not resume:\n{log}"));
+    let number_after = |marker: &str| -> Option<u64> {
+        let rest = &line[line.find(marker)? + marker.len()..];
+        rest.split(|c: char| !c.is_ascii_digit())
+            .next()?
+            .parse()
+            .ok()
+    };
+    let at = number_after("resumed supervisors at tick ").expect("a tick");
+    assert!(
+        at > lost,
+        "resumed at tick {at}, not after the loss at {lost}: {line}"
+    );
+    if let Some(recorded) = number_after("from the snapshot of tick ") {
+        assert!(
+            (1..lost).contains(&recorded),
+            "resumed from tick {recorded}, not a record before the loss at {lost}: {line}"
+        );
+    } else {
+        assert!(line.contains("its initial states"), "{line}");
+    }
 }
 
 /// A run on hosts `names`; host 1 goes with `take_down` (given the hosts and the run directory) once it ticks, is
@@ -316,7 +347,7 @@ fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Pat
         hosts.daemons[1].log()
     );
     run.interrupt();
-    assert_lost_and_rejoined(out.path());
+    assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
     hosts.stop_and_check_clean();
 }
 
@@ -368,6 +399,6 @@ fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns(
         hosts.daemons[1].log()
     );
     run.interrupt();
-    assert_lost_and_rejoined(out.path());
+    assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
     hosts.stop_and_check_clean();
 }

@@ -2,14 +2,16 @@
 //!
 //! The share names the experiment by path (every host must see the same configuration and model files at the same
 //! path, e.g. one checkout or a shared file system), the run seed, and the run-wide ids and controllers of the
-//! robots the host runs. Both messages travel with the wire's bincode configuration ([`super::codec`]).
+//! robots the host runs, and when the host rejoins, where each robot's supervisors left off. Both messages travel with the wire's bincode configuration ([`super::codec`]).
 
 use std::path::PathBuf;
 
 use bincode::{Decode, Encode};
 
+use crate::messages::SupervisorSnapshot;
+
 /// What the world asks a host to run.
-#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode)]
+#[derive(Debug, Clone, PartialEq, Encode, Decode)]
 pub struct Assignment {
     /// Identity of the run (every message of the run carries it).
     pub run: u64,
@@ -31,6 +33,9 @@ pub struct Assignment {
     pub tick_deadline_ms: u64,
     /// How long the host may take to start its agents (milliseconds).
     pub join_timeout_ms: u64,
+    /// For a host that rejoins: each robot's last recorded supervisor snapshot and the tick it came with, in the
+    /// order of `robots`, so its fresh agent resumes where the robot left off. Empty on the first assignment.
+    pub resume: Vec<(u64, SupervisorSnapshot)>,
 }
 
 /// The host's answer to an [`Assignment`].

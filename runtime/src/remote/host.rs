@@ -32,6 +32,7 @@ use super::{RemoteError, keys};
 use crate::launcher::binaries::Binaries;
 use crate::launcher::children::{self, Children};
 use crate::launcher::process_args::{AgentArgs, RunArgs};
+use crate::launcher::resume::ResumePoint;
 use crate::launcher::run_dir;
 use crate::messages::SensorFrame;
 use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink};
@@ -400,6 +401,7 @@ impl Share {
             run: self.spec.name().to_owned(),
             iox_root: self.spec.root_dir().to_path_buf(),
         };
+        let resume = self.write_resume_points(logs)?;
         for (slot, (robot, controller)) in self.assignment.robots.iter().enumerate() {
             let args = AgentArgs {
                 run: run.clone(),
@@ -409,7 +411,7 @@ impl Share {
                 seed: self.assignment.seed,
                 robots: self.assignment.robots_override,
                 compiled_supervisors: None,
-                resume: None,
+                resume: resume.get(slot).cloned(),
             };
             let log_path = log_file(logs, *robot);
             let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
@@ -431,6 +433,23 @@ impl Share {
             self.children.agents.push(Some(child));
         }
         Ok(())
+    }
+
+    /// Writes a rejoining share's resume points (`<logs>/resume/robot-<id>.json`, as in a run directory) and
+    /// returns them in slot order; none on a first assignment.
+    fn write_resume_points(&self, logs: &Path) -> Result<Vec<PathBuf>, RemoteError> {
+        let robots = self.assignment.robots.iter().map(|(id, _)| *id);
+        robots
+            .zip(&self.assignment.resume)
+            .map(|(robot, &(tick, snapshot))| {
+                let point = ResumePoint {
+                    robot,
+                    tick,
+                    snapshot,
+                };
+                Ok(point.write(logs)?)
+            })
+            .collect()
     }
 
     /// Waits for every agent to join; an agent that exits first fails the share with the end of its log.
@@ -497,6 +516,7 @@ impl Share {
             return Ok(());
         };
         let frames = &self.frames;
+        link.start_at(header.tick);
         link.tick_with(|_, local| local.copy_from_slice(frames))?;
         for (slot, reply) in self.replies.iter_mut().enumerate() {
             *reply = match (link.statuses()[slot], link.command(slot as u32)) {

@@ -59,6 +59,9 @@ pub enum RemoteError {
     /// The robot-agent program is missing.
     #[error(transparent)]
     Binaries(#[from] crate::launcher::binaries::BinariesError),
+    /// A rejoining share's resume point could not be written.
+    #[error(transparent)]
+    Resume(#[from] crate::launcher::resume::ResumeError),
     /// A file or process operation failed.
     #[error("{what}: {source}")]
     Io {

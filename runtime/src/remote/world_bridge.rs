@@ -492,6 +492,18 @@ impl RemoteHosts {
                 .collect(),
             tick_deadline_ms: (self.options.tick_deadline / 2).as_millis() as u64,
             join_timeout_ms: self.options.join_timeout.as_millis() as u64,
+            resume: if host.epoch > 1 {
+                host.share
+                    .robots
+                    .iter()
+                    .map(|&r| {
+                        let last = &self.commands[r as usize];
+                        (last.tick, last.supervisors)
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
         };
         let payload = codec::encode_message(&assignment)?;
         let sender = self.sender.clone();

@@ -229,6 +229,14 @@ impl WorldLink {
         self.tick
     }
 
+    /// Numbers the first tick `first` instead of 1, so a host that joins a run mid-way gives its agents the
+    /// world's tick numbers (their timers and random streams are positioned by tick). No effect once a tick ran.
+    pub fn start_at(&mut self, first: u64) {
+        if self.tick == 0 {
+            self.tick = first.saturating_sub(1);
+        }
+    }
+
     /// Blocks until every robot has an agent or `timeout` passes, giving replacement agents that join meanwhile
     /// their fresh command boards.
     pub fn wait_for_agents(&mut self, timeout: Duration) -> Result<(), TransportError> {
