@@ -105,6 +105,12 @@ fn same_seed_gives_identical_trajectory_and_events() {
             &["--ticks", "60", "--seed", seed],
         );
         let read = |name: &str| std::fs::read(out.path().join(name)).expect("record exists");
+        let summary: serde_json::Value =
+            serde_json::from_slice(&read("summary.json")).expect("summary.json is JSON");
+        assert_eq!(
+            summary["commands_missing"], 0,
+            "every command arrived by its deadline, so the run is a function of its seed"
+        );
         (read("trajectory.csv"), read("events.csv"))
     };
     let first = records("7");

@@ -25,6 +25,8 @@ pub struct RunResult {
     pub wall_seconds: f64,
     /// Robots whose agent died during the run.
     pub deaths: usize,
+    /// Commands that missed their tick's deadline (robot-ticks); 0 in a run that is a pure function of its seed.
+    pub commands_missing: u64,
     /// The task metrics by name.
     pub metrics: BTreeMap<String, f64>,
 }
@@ -60,6 +62,7 @@ impl RunResult {
             ticks: summary["ticks"].as_u64().unwrap_or(0),
             wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(0.0),
             deaths: summary["deaths"].as_array().map_or(0, Vec::len),
+            commands_missing: summary["commands_missing"].as_u64().unwrap_or(0),
             metrics,
         })
     }
@@ -168,7 +171,15 @@ pub fn metric_names(runs: &[RunResult]) -> Vec<String> {
 }
 
 /// Columns of `results.csv` between the factors and the metrics.
-const FIXED_COLUMNS: [&str; 6] = ["robots", "seed", "runs", "ticks", "wall_seconds", "deaths"];
+const FIXED_COLUMNS: [&str; 7] = [
+    "robots",
+    "seed",
+    "runs",
+    "ticks",
+    "wall_seconds",
+    "deaths",
+    "commands_missing",
+];
 
 /// `results.csv`: one row per finished run (`kind` = `run`) and one per configuration (`kind` =
 /// `configuration`: the median run's values, the number of runs and each metric's mean, min and max).
@@ -219,6 +230,7 @@ pub fn csv(
             r.ticks.to_string(),
             format!("{:.3}", r.wall_seconds),
             r.deaths.to_string(),
+            r.commands_missing.to_string(),
         ]);
         row.extend(
             metrics
@@ -281,6 +293,7 @@ mod tests {
             ticks: 100,
             wall_seconds: 1.0,
             deaths: 0,
+            commands_missing: 0,
             metrics: BTreeMap::from([("TO".to_owned(), time), ("yield".to_owned(), seed as f64)]),
         }
     }
@@ -345,13 +358,14 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "kind,configuration,E,robots,seed,runs,ticks,wall_seconds,deaths,TO,metrics.ticks,yield,TO_mean,TO_min,\
+            "kind,configuration,E,robots,seed,runs,ticks,wall_seconds,deaths,commands_missing,TO,metrics.ticks,yield,\
+             TO_mean,TO_min,\
              TO_max,metrics.ticks_mean,metrics.ticks_min,metrics.ticks_max,yield_mean,yield_min,yield_max"
         );
-        assert_eq!(lines[1], "run,E-0,0,4,1,,100,1.000,0,3,100,1,,,,,,,,,");
+        assert_eq!(lines[1], "run,E-0,0,4,1,,100,1.000,0,0,3,100,1,,,,,,,,,");
         assert_eq!(
             lines[3],
-            "configuration,E-0,0,4,1,2,100,1.000,0,3,100,1,4,3,5,100,100,100,1.5,1,2"
+            "configuration,E-0,0,4,1,2,100,1.000,0,0,3,100,1,4,3,5,100,100,100,1.5,1,2"
         );
         assert_eq!(lines.len(), 4);
     }

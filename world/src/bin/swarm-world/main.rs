@@ -148,6 +148,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
     let mut robot_steps: u64 = 0;
+    // Commands that missed their tick's deadline: a run with none is a pure function of (config, seed, faults).
+    let mut commands_missing: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
     while !stop.load(Ordering::Relaxed)
@@ -185,6 +187,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         events.flush()?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);
+        commands_missing += u64::from(outcome.missing);
         if outcome.tick == 1 || last_report.elapsed() >= REPORT_INTERVAL {
             last_report = Instant::now();
             report(WorldReport::Tick {
@@ -200,6 +203,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let ticks = link.tick();
     let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
+        "commands_missing": commands_missing,
         "ticking_seconds": ticking,
         "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
