@@ -346,6 +346,11 @@ fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Pat
         "the restarted host never ticked:\n{}",
         hosts.daemons[1].log()
     );
+    assert!(
+        hosts.daemons[1].wait_for("the share's robots take part", EVENT_TIMEOUT),
+        "the rejoined host's robots never took part again:\n{}",
+        hosts.daemons[1].log()
+    );
     run.interrupt();
     assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
     hosts.stop_and_check_clean();
@@ -396,6 +401,11 @@ fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns(
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
         "the host never ticked after its link returned:\n{}",
+        hosts.daemons[1].log()
+    );
+    assert!(
+        hosts.daemons[1].wait_for("the share's robots take part", EVENT_TIMEOUT),
+        "the rejoined host's robots never took part again:\n{}",
         hosts.daemons[1].log()
     );
     run.interrupt();

@@ -300,6 +300,9 @@ struct Share {
     replies: Vec<Reply>,
     buf: Vec<u8>,
     last_tick: u64,
+    /// Whether a tick ran in which the share's live robots all answered (a rejoined share's robots are dead for
+    /// the world at first).
+    took_part: bool,
     dropped: Dropped,
     publisher: Publisher<'static>,
     _frames: Subscriber<()>,
@@ -373,6 +376,7 @@ impl Share {
             replies: vec![Reply::Missing; count as usize],
             buf: Vec::new(),
             last_tick: 0,
+            took_part: false,
             dropped: Dropped::default(),
             spec,
             link: Some(link),
@@ -433,6 +437,17 @@ impl Share {
             self.children.agents.push(Some(child));
         }
         Ok(())
+    }
+
+    /// Whether this tick had live robots and every one of them answered (so each has stepped its controller).
+    fn live_robots_answered(&self) -> bool {
+        let mut live = self
+            .frames
+            .iter()
+            .zip(&self.replies)
+            .filter(|(frame, _)| frame.alive != 0)
+            .peekable();
+        live.peek().is_some() && live.all(|(_, reply)| matches!(reply, Reply::Answered(_)))
     }
 
     /// Writes a rejoining share's resume points (`<logs>/resume/robot-<id>.json`, as in a run directory) and
@@ -532,6 +547,10 @@ impl Share {
         }
         if self.last_tick == 0 {
             tracing::info!(tick = header.tick, "first tick of the share");
+        }
+        if !self.took_part && self.live_robots_answered() {
+            self.took_part = true;
+            tracing::info!(tick = header.tick, "the share's robots take part");
         }
         self.last_tick = header.tick;
         let out = Header::new(

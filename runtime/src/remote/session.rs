@@ -65,11 +65,6 @@ pub struct TlsFileError {
 }
 
 impl TlsFiles {
-    /// Whether any file is set.
-    pub fn is_set(&self) -> bool {
-        self.root_ca.is_some() || self.certificate.is_some() || self.private_key.is_some()
-    }
-
     /// Checks that every file set can be read, so a wrong path is reported by name before zenoh starts.
     pub fn check_readable(&self) -> Result<(), TlsFileError> {
         let files = [
