@@ -197,6 +197,7 @@ pub fn spawn_swarm(args: &[&str]) -> std::process::Child {
         .spawn()
         .expect("swarm starts")
 }
+
 /// Runs `swarm ctl <out> <request>` against a live run and returns its standard output (it must succeed).
 pub fn swarm_ctl(out: &Path, request: &[&str]) -> String {
     let output = Command::new(bin_dir().join("swarm"))

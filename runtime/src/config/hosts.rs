@@ -275,25 +275,26 @@ mod tests {
         )
     }
 
-    fn load(text: &str) -> Result<Option<HostsConfig>, ConfigErrors> {
+    /// Writes an experiment with `hosts` into `dir`; returns its path.
+    fn write_experiment(dir: &Path, hosts: &str) -> PathBuf {
+        let path = dir.join("x.argos");
+        std::fs::write(&path, experiment(hosts)).expect("write");
+        path
+    }
+
+    fn load(hosts: &str) -> Result<Option<HostsConfig>, ConfigErrors> {
         let dir = tempfile::tempdir().expect("a temporary directory");
-        let path = dir.path().join("x.argos");
-        std::fs::write(&path, text).expect("write");
-        HostsConfig::load(&path)
+        HostsConfig::load(&write_experiment(dir.path(), hosts))
     }
 
     #[test]
     fn hosts_with_weights_and_paths_relative_to_the_experiment() {
         let dir = tempfile::tempdir().expect("a temporary directory");
-        let path = dir.path().join("x.argos");
-        std::fs::write(
-            &path,
-            experiment(
-                r#"<hosts listen="tcp/10.0.0.1:7447, tcp/10.0.1.1:7447" lease_ms="800" user="swarm" password_file="pw">
+        let path = write_experiment(
+            dir.path(),
+            r#"<hosts listen="tcp/10.0.0.1:7447, tcp/10.0.1.1:7447" lease_ms="800" user="swarm" password_file="pw">
                      <host name="a" weight="3" /><host name="b" /></hosts>"#,
-            ),
-        )
-        .expect("write");
+        );
         let config = HostsConfig::load(&path).expect("valid").expect("present");
         assert_eq!(config.listen, ["tcp/10.0.0.1:7447", "tcp/10.0.1.1:7447"]);
         assert_eq!(config.lease_ms, Some(800));
@@ -308,14 +309,12 @@ mod tests {
 
     #[test]
     fn an_experiment_without_hosts_runs_locally() {
-        assert_eq!(load(&experiment("")).expect("valid"), None);
+        assert_eq!(load("").expect("valid"), None);
     }
 
     #[test]
     fn bad_hosts_are_located_errors() {
-        let errors = load(&experiment(
-            "<hosts lease_ms=\"0\">\n<host name=\"a/b\" />\n<host name=\"c\" weight=\"-1\" />\n<host name=\"d\" /><host name=\"d\" /></hosts>",
-        ))
+        let errors = load("<hosts lease_ms=\"0\">\n<host name=\"a/b\" />\n<host name=\"c\" weight=\"-1\" />\n<host name=\"d\" /><host name=\"d\" /></hosts>")
         .expect_err("invalid");
         let text = errors.to_string();
         assert!(
@@ -333,14 +332,10 @@ mod tests {
     #[test]
     fn tls_files_are_relative_to_the_experiment() {
         let dir = tempfile::tempdir().expect("a temporary directory");
-        let path = dir.path().join("x.argos");
-        std::fs::write(
-            &path,
-            experiment(
-                r#"<hosts listen="tls/10.0.0.1:7447" tls_certificate="pki/world.pem" tls_private_key="pki/world.key" tls_root_ca="pki/ca.pem"><host name="a" /></hosts>"#,
-            ),
-        )
-        .expect("write");
+        let path = write_experiment(
+            dir.path(),
+            r#"<hosts listen="tls/10.0.0.1:7447" tls_certificate="pki/world.pem" tls_private_key="pki/world.key" tls_root_ca="pki/ca.pem"><host name="a" /></hosts>"#,
+        );
         let config = HostsConfig::load(&path).expect("valid").expect("present");
         assert_eq!(
             config.tls,
@@ -354,19 +349,15 @@ mod tests {
 
     #[test]
     fn incomplete_tls_settings_are_located_errors() {
-        let errors = load(&experiment(
-            "<hosts tls_certificate=\"w.pem\">\n<host name=\"a\" /></hosts>",
-        ))
-        .expect_err("invalid");
+        let errors = load("<hosts tls_certificate=\"w.pem\">\n<host name=\"a\" /></hosts>")
+            .expect_err("invalid");
         let text = errors.to_string();
         assert!(
             text.contains(":4:1: <hosts> needs both 'tls_certificate' and 'tls_private_key'"),
             "{text}"
         );
-        let errors = load(&experiment(
-            "<hosts tls_root_ca=\"ca.pem\"><host name=\"a\" /></hosts>",
-        ))
-        .expect_err("invalid");
+        let errors =
+            load("<hosts tls_root_ca=\"ca.pem\"><host name=\"a\" /></hosts>").expect_err("invalid");
         let text = errors.to_string();
         assert!(
             text.contains(

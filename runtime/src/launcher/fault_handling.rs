@@ -334,7 +334,6 @@ impl Supervision {
         Ok(pid)
     }
 
-    /// SIGKILLs `robot`'s agent and reaps it, so its end is not seen again as an unscheduled death.
     /// `swarm ctl kill-host`: the world tells the host to die; its loss is logged when the world notices it.
     fn kill_host(&mut self, host: &str) -> Result<String, String> {
         let Some(index) = self.host_names.iter().position(|h| h == host) else {
@@ -353,6 +352,7 @@ impl Supervision {
         Ok(format!("host {host} killed\n"))
     }
 
+    /// SIGKILLs `robot`'s agent and reaps it, so its end is not seen again as an unscheduled death.
     fn kill_and_reap(&mut self, robot: u32) {
         self.children.kill_agent(robot);
         self.robots[robot as usize].state = AgentState::Dead;

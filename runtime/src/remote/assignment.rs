@@ -2,7 +2,8 @@
 //!
 //! The share names the experiment by path (every host must see the same configuration and model files at the same
 //! path, e.g. one checkout or a shared file system), the run seed, and the run-wide ids and controllers of the
-//! robots the host runs, and when the host rejoins, where each robot's supervisors left off. Both messages travel with the wire's bincode configuration ([`super::codec`]).
+//! robots the host runs, and when the host rejoins, where each robot's supervisors left off. Both messages travel
+//! with the wire's bincode configuration ([`super::codec`]).
 
 use std::path::PathBuf;
 

@@ -160,11 +160,10 @@ impl ZenohOptions {
             set(&mut config, "transport/auth/usrpwd/user", &json(user))?;
         }
         if let Some(password) = &self.password {
-            set(
-                &mut config,
-                "transport/auth/usrpwd/password",
-                &json(password),
-            )?;
+            // Not through `set`: its error would quote the password.
+            config
+                .insert_json5("transport/auth/usrpwd/password", &json(password))
+                .map_err(zenoh_error("setting zenoh's password"))?;
         }
         if let Some(file) = &self.credentials_file {
             set(
@@ -212,12 +211,8 @@ impl ZenohOptions {
     pub fn open_world(&self, listen: &[String]) -> Result<Session, RemoteError> {
         let mut config = self.config("peer", TlsSide::Listen)?;
         let endpoints = serde_json::to_string(listen).unwrap_or_else(|_| "[]".into());
-        config
-            .insert_json5("listen/endpoints", &endpoints)
-            .map_err(zenoh_error(format!("listening on {endpoints}")))?;
-        config
-            .insert_json5("connect/endpoints", "[]")
-            .map_err(zenoh_error("clearing connect endpoints"))?;
+        set(&mut config, "listen/endpoints", &endpoints)?;
+        set(&mut config, "connect/endpoints", "[]")?;
         zenoh::open(config).wait().map_err(zenoh_error(format!(
             "opening the world's session on {endpoints}"
         )))
