@@ -110,9 +110,11 @@ fn read(out: &Path, name: &str) -> Vec<u8> {
     std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-#[test]
-fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
-    let common = [
+/// Runs the obstacle-avoidance experiment (10 robots, 150 ticks, seed 11, plus `extra` arguments) once on this
+/// machine and once on two hosts; checks the hosts shared the robots and the records are the same byte for byte.
+/// Returns both summaries (single host first) and the hosts, still running.
+fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value, Hosts) {
+    let mut common = vec![
         "--robots",
         "10",
         "--ticks",
@@ -121,10 +123,11 @@ fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
         "11",
         "--no-progress",
     ];
+    common.extend(extra);
     let single = tempfile::tempdir().expect("a temporary directory");
     let out = single.path().display().to_string();
     let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
-    args.extend(common);
+    args.extend(&common);
     let outcome = swarm(&args);
     assert!(
         outcome.output.status.success(),
@@ -137,7 +140,7 @@ fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     let out = multi.path().display().to_string();
     let host_args = hosts.run_args();
     let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
-    args.extend(common);
+    args.extend(&common);
     args.extend(host_args.iter().map(String::as_str));
     let outcome = swarm(&args);
     assert!(
@@ -147,9 +150,9 @@ fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     );
     assert_clean(&outcome);
 
-    let summary = summary(multi.path());
-    assert_eq!(summary["ticks"], 150);
-    let shares = summary["hosts"]["hosts"]
+    let multi_summary = summary(multi.path());
+    assert_eq!(multi_summary["ticks"], 150);
+    let shares = multi_summary["hosts"]["hosts"]
         .as_array()
         .expect("hosts in the summary");
     let sizes: Vec<usize> = shares
@@ -158,7 +161,9 @@ fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
         .collect();
     assert_eq!(sizes, [5, 5], "10 robots shared equally by two hosts");
     assert_eq!(
-        summary["processes"]["agents"].as_array().map(Vec::len),
+        multi_summary["processes"]["agents"]
+            .as_array()
+            .map(Vec::len),
         Some(0),
         "the launcher started no local agent"
     );
@@ -170,6 +175,85 @@ fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
         read(single.path(), "events.csv") == read(multi.path(), "events.csv"),
         "events.csv of the two-host run differs from the single-host run with the same seed"
     );
+    (summary(single.path()), multi_summary, hosts)
+}
+
+#[test]
+fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
+    let (_, _, hosts) = single_and_two_hosts(&[]);
+    hosts.stop_and_check_clean();
+}
+
+/// The robot faults of a run on hosts, as `(what, robot, scheduled tick, restarted, rejoin tick)`.
+fn fault_log(summary: &serde_json::Value) -> Vec<(String, u64, u64, bool, Option<u64>)> {
+    summary["faults"]
+        .as_array()
+        .expect("faults are listed")
+        .iter()
+        .filter(|f| f["robot"].is_u64() && f["scheduled_tick"].is_u64())
+        .map(|f| {
+            (
+                f["what"].as_str().unwrap_or_default().to_owned(),
+                f["robot"].as_u64().unwrap_or_default(),
+                f["scheduled_tick"].as_u64().unwrap_or_default(),
+                f["restarted"] == true,
+                f["rejoin_tick"].as_u64(),
+            )
+        })
+        .collect()
+}
+
+/// A fault schedule with restarts on hosts: the hosts kill, freeze and thaw their agents and start replacements
+/// that resume from the world's record, between the same ticks as a single-host run does, so the records are the
+/// same byte for byte; the fault logs agree too.
+#[test]
+fn a_fault_schedule_with_restarts_on_hosts_reproduces_the_single_host_run() {
+    let (single, multi, hosts) = single_and_two_hosts(&[
+        "--fault",
+        "restart policy=on-failure robots=1,2,7 backoff=0.25",
+        "--fault",
+        "kill robots=1 tick=0",
+        "--fault",
+        "kill robots=2,7 tick=30",
+        "--fault",
+        "freeze robots=4 tick=40",
+        "--fault",
+        "thaw robots=4 tick=70",
+        "--fault",
+        "kill robots=9 tick=90",
+    ]);
+    let log = fault_log(&multi);
+    assert_eq!(log, fault_log(&single), "{multi}");
+    let restarted_kill = |robot: u64| {
+        log.iter()
+            .find(|(what, r, tick, ..)| what == "kill" && *r == robot && *tick == 30)
+            .map(|(.., restarted, rejoin)| (*restarted, *rejoin))
+    };
+    // backoff 0.25 s at 20 ticks/s: the replacements take part from tick 35.
+    assert_eq!(restarted_kill(2), Some((true, Some(35))), "{log:?}");
+    assert_eq!(restarted_kill(7), Some((true, Some(35))), "{log:?}");
+    assert!(
+        log.iter()
+            .any(|(what, r, tick, restarted, _)| what == "kill"
+                && *r == 9
+                && *tick == 90
+                && !restarted),
+        "robot 9 has no restart rule: {log:?}"
+    );
+    assert_eq!(multi["alive_final"], 9, "only robot 9 stays dead");
+    for robot in [2u64, 7] {
+        let host = hosts
+            .daemons
+            .iter()
+            .find(|d| d.agent_log(robot).contains("resumed supervisors"))
+            .unwrap_or_else(|| panic!("no host's agent of robot {robot} resumed"));
+        let agent_log = host.agent_log(robot);
+        assert!(
+            agent_log.contains("resumed supervisors at tick 35 from the snapshot of tick 29"),
+            "robot {robot}'s replacement on host {}:\n{agent_log}",
+            host.name
+        );
+    }
     hosts.stop_and_check_clean();
 }
 
@@ -181,7 +265,8 @@ struct BackgroundRun {
 }
 
 impl BackgroundRun {
-    fn start(out: &Path, hosts: &Hosts) -> BackgroundRun {
+    /// `swarm run` of the fault tests' experiment on `hosts`, with `extra` arguments.
+    fn start(out: &Path, hosts: &Hosts, extra: &[&str]) -> BackgroundRun {
         let dir = bin_dir();
         let mut child = Command::new(dir.join("swarm"))
             .args([
@@ -194,6 +279,7 @@ impl BackgroundRun {
             .args(["--tick-deadline-ms", "200", "--no-progress", "--out"])
             .arg(out)
             .args(hosts.run_args())
+            .args(extra)
             .env("SWARM_BIN_DIR", dir)
             .env("RUST_LOG", "info,zenoh=warn")
             .current_dir(workspace_root())
@@ -330,7 +416,7 @@ fn assert_resumed_after(log: &str, lost: u64) {
 fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Path)) {
     let mut hosts = Hosts::start(names);
     let out = tempfile::tempdir().expect("a temporary directory");
-    let mut run = BackgroundRun::start(out.path(), &hosts);
+    let mut run = BackgroundRun::start(out.path(), &hosts, &[]);
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
         "host {} never ticked:\n{}",
@@ -386,7 +472,7 @@ fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns(
         return;
     }
     let out = tempfile::tempdir().expect("a temporary directory");
-    let mut run = BackgroundRun::start(out.path(), &hosts);
+    let mut run = BackgroundRun::start(out.path(), &hosts, &[]);
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
         "host zeta never ticked:\n{}",
@@ -410,5 +496,74 @@ fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns(
     );
     run.interrupt();
     assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
+    hosts.stop_and_check_clean();
+}
+
+/// The process id of host `daemon`'s agent for robot `robot` (one of its child processes).
+fn agent_pid(daemon: &HostDaemon, robot: u64) -> Option<i32> {
+    let children = std::fs::read_to_string(format!(
+        "/proc/{pid}/task/{pid}/children",
+        pid = daemon.pid()
+    ))
+    .ok()?;
+    let wanted = ["--robot".to_owned(), robot.to_string()];
+    children
+        .split_whitespace()
+        .filter_map(|pid| pid.parse::<i32>().ok())
+        .find(|pid| {
+            let cmdline = std::fs::read(format!("/proc/{pid}/cmdline")).unwrap_or_default();
+            let args: Vec<String> = cmdline
+                .split(|&b| b == 0)
+                .map(|a| String::from_utf8_lossy(a).into_owned())
+                .collect();
+            args.windows(2).any(|pair| pair == wanted)
+        })
+}
+
+/// An agent that dies on a host outside any schedule is reported by its host, and its restart policy has the
+/// host start a replacement that resumes and takes part again, as a local agent would.
+#[test]
+fn an_agent_killed_on_a_host_is_restarted_there_by_its_policy() {
+    let mut hosts = Hosts::start(&["alpha", "beta"]);
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let mut run = BackgroundRun::start(
+        out.path(),
+        &hosts,
+        &["--fault", "restart policy=on-failure backoff=0.05"],
+    );
+    assert!(
+        hosts.daemons[1].wait_for("the share's robots take part", EVENT_TIMEOUT),
+        "host beta never ticked:\n{}",
+        hosts.daemons[1].log()
+    );
+    let robot = (0..RUN_ROBOTS as u64)
+        .find(|&r| !hosts.daemons[1].agent_log(r).is_empty())
+        .expect("beta runs a robot");
+    let pid = agent_pid(&hosts.daemons[1], robot).expect("beta's agent process of the robot");
+    kill(Pid::from_raw(pid), Signal::SIGKILL).expect("kill the agent");
+    run.wait_for(&format!("robot {robot} takes part again from tick"));
+    let replacement = agent_pid(&hosts.daemons[1], robot).expect("a replacement agent on beta");
+    assert_ne!(replacement, pid, "a new process");
+    run.interrupt();
+
+    let summary = summary(out.path());
+    let restarted = summary["faults"]
+        .as_array()
+        .expect("faults are listed")
+        .iter()
+        .find(|f| f["what"] == "exit" && f["robot"] == robot)
+        .unwrap_or_else(|| panic!("the death is logged: {summary}"))
+        .clone();
+    let down = restarted["detection_tick"].as_u64().expect("detected");
+    let back = restarted["rejoin_tick"].as_u64().expect("rejoined");
+    assert!(restarted["restarted"] == true && down < back, "{restarted}");
+    assert_resumed_after(&hosts.daemons[1].agent_log(robot), down - 1);
+    for (tick, alive) in alive_over_time(out.path(), robot as usize, RUN_ROBOTS) {
+        assert_eq!(
+            alive,
+            tick < down || tick >= back,
+            "robot {robot} alive at tick {tick} (down {down}, back {back})"
+        );
+    }
     hosts.stop_and_check_clean();
 }

@@ -1,9 +1,12 @@
 //! The launcher's part of fault handling: applying the faults the world reports due, following deaths and
 //! returns the world reports, restarting agents by policy, and answering `swarm ctl`.
 //!
-//! The launcher is the only one that signals processes; the world is the one that decides at which tick
+//! The launcher is the only one that signals local processes; the world is the one that decides at which tick
 //! something takes effect. A scheduled kill is applied and reaped before the launcher answers `applied`, so
-//! the killed agent never produces a second, unscheduled death.
+//! the killed agent never produces a second, unscheduled death. In a run on hosts the launcher keeps the fault
+//! log and decides restarts just the same, but the agents are the hosts' processes: the world has the hosts
+//! carry out the faults, and a restart is a `respawn r` line to the world, which has the robot's host start the
+//! replacement.
 
 use std::process::ExitStatus;
 use std::time::Instant;
@@ -78,6 +81,13 @@ impl Supervision {
                 });
                 self.restart_scheduled(robot, tick, index, true)?;
             }
+            // On hosts the world has the robot's host send the signal.
+            FaultKind::Freeze if self.on_hosts() => {
+                self.robots[robot as usize].state = AgentState::Frozen
+            }
+            FaultKind::Thaw if self.on_hosts() => {
+                self.robots[robot as usize].state = AgentState::Running
+            }
             FaultKind::Freeze => self.signal_agent(robot, Signal::SIGSTOP, AgentState::Frozen),
             FaultKind::Thaw => self.signal_agent(robot, Signal::SIGCONT, AgentState::Running),
             FaultKind::KillWorld => {}
@@ -105,15 +115,24 @@ impl Supervision {
             return;
         };
         let gone_at = entry.gone_at;
-        let index = match entry.open_fault {
-            Some(index) if self.faults[index].detection_tick.is_none() => index,
+        let index = match (entry.open_fault, cause) {
+            (_, DownCause::HostLost) => self.log_fault("host-lost", Some(robot), None),
+            (Some(index), _) if self.faults[index].detection_tick.is_none() => index,
+            (_, DownCause::Notice) if self.on_hosts() => self.log_fault("exit", Some(robot), None),
             _ => self.log_fault("deadline", Some(robot), None),
         };
         self.faults[index].detection_tick = Some(tick);
         self.faults[index].detection_ms = gone_at.map(millis_since);
-        if cause == DownCause::Deadline {
+        match cause {
             // Its agent still runs (frozen or late); the world takes it back when it answers again.
-            return;
+            DownCause::Deadline => return,
+            // The host's return restarts it, whatever its policy.
+            DownCause::HostLost => {
+                self.robots[robot as usize].state = AgentState::Restarting;
+                self.robots[robot as usize].open_fault = Some(index);
+                return;
+            }
+            DownCause::Notice => {}
         }
         let entry = &mut self.robots[robot as usize];
         // A death the launcher did not see (a notice from elsewhere) counts as a failure.
@@ -232,6 +251,13 @@ impl Supervision {
         if let CtlCommand::KillHost(host) = &command {
             return self.kill_host(host);
         }
+        if self.on_hosts() {
+            return Err(
+                "this run's robots run on hosts: `swarm ctl` kills, freezes and thaws local agents only; \
+                 schedule robot faults with <faults> or --fault, or use kill-host"
+                    .into(),
+            );
+        }
         let (CtlCommand::Kill(robot) | CtlCommand::Freeze(robot) | CtlCommand::Thaw(robot)) =
             command
         else {
@@ -319,8 +345,14 @@ impl Supervision {
         Ok(())
     }
 
-    /// Starts a replacement agent for `robot` (from its resume point when `resume`); returns its pid.
+    /// Starts a replacement agent for `robot` (from its resume point when `resume`); returns its pid (0 on
+    /// hosts: the world has the robot's host start it, always from the world's record).
     fn spawn_replacement(&mut self, robot: u32, resume: bool) -> Result<u32, LaunchError> {
+        if self.on_hosts() {
+            tracing::info!(robot, "restarting the robot's agent on its host");
+            self.send_world(WorldCommand::Respawn(robot));
+            return Ok(0);
+        }
         let point = resume.then(|| ResumePoint::path(&self.out_dir, robot));
         let child = self
             .spawner
@@ -350,6 +382,11 @@ impl Supervision {
         let record = self.log_fault("ctl-kill-host", None, None);
         self.faults[record].status = Some(format!("host {host}"));
         Ok(format!("host {host} killed\n"))
+    }
+
+    /// Whether the run's robots run on hosts.
+    fn on_hosts(&self) -> bool {
+        !self.host_names.is_empty()
     }
 
     /// SIGKILLs `robot`'s agent and reaps it, so its end is not seen again as an unscheduled death.

@@ -2,8 +2,9 @@
 //!
 //! `dead 3` (the OS reported robot 3's agent gone), `rejoin 3 58` (robot 3's replacement takes part from tick
 //! 58: the world holds that tick until it has joined) and `applied 50` (every fault due at tick 50 is done: the
-//! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`). Plain
-//! text, so a person can drive a world by hand.
+//! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`) and
+//! `respawn 3` (robot 3 runs on a host and its restart policy replaces its agent: the world has the host start one
+//! that resumes from the world's record). Plain text, so a person can drive a world by hand.
 
 use std::fmt;
 
@@ -23,6 +24,8 @@ pub enum WorldCommand {
     Applied(u64),
     /// Host with this index in the placement is to die.
     KillHost(u32),
+    /// Robot (on a host) gets a replacement agent.
+    Respawn(u32),
 }
 
 impl fmt::Display for WorldCommand {
@@ -32,6 +35,7 @@ impl fmt::Display for WorldCommand {
             WorldCommand::Rejoin { robot, tick } => write!(f, "rejoin {robot} {tick}"),
             WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
             WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
+            WorldCommand::Respawn(robot) => write!(f, "respawn {robot}"),
         }
     }
 }
@@ -48,6 +52,7 @@ impl WorldCommand {
             }),
             ["applied", tick] => Some(WorldCommand::Applied(tick.parse().ok()?)),
             ["kill-host", host] => Some(WorldCommand::KillHost(host.parse().ok()?)),
+            ["respawn", robot] => Some(WorldCommand::Respawn(robot.parse().ok()?)),
             _ => None,
         }
     }
@@ -64,6 +69,7 @@ mod tests {
             WorldCommand::Rejoin { robot: 3, tick: 58 },
             WorldCommand::Applied(50),
             WorldCommand::KillHost(1),
+            WorldCommand::Respawn(4),
         ] {
             assert_eq!(WorldCommand::parse(&command.to_string()), Some(command));
         }

@@ -4,7 +4,7 @@
 //! `ready 40`, `tick 120 answered 39 missing 0 dead 1`, `finished 600`, and for faults `fault 50 kill 3`
 //! (a scheduled fault is due; after the last one of a tick, `await 50`: the world waits for the launcher's
 //! `applied 50`), `down 51 3 notice` (the world
-//! marked robot 3 dead at tick 51) and `up 80 3` (robot 3 takes part again from tick 80). Anything else on the
+//! marked robot 3 dead at tick 51; `deadline` when it missed one, `host` when its host was lost) and `up 80 3` (robot 3 takes part again from tick 80). Anything else on the
 //! world's standard output is ignored by the launcher.
 
 use std::fmt;
@@ -74,6 +74,8 @@ pub enum DownCause {
     Notice,
     /// The robot missed a tick's deadline (frozen, hung, or gone without a notice).
     Deadline,
+    /// The robot's host was lost (it is back when the host is).
+    HostLost,
 }
 
 impl DownCause {
@@ -82,6 +84,7 @@ impl DownCause {
         match self {
             DownCause::Notice => "notice",
             DownCause::Deadline => "deadline",
+            DownCause::HostLost => "host",
         }
     }
 }
@@ -150,7 +153,7 @@ impl WorldReport {
             ["down", tick, robot, cause] => Some(WorldReport::Down {
                 tick: tick.parse().ok()?,
                 robot: robot.parse().ok()?,
-                cause: [DownCause::Notice, DownCause::Deadline]
+                cause: [DownCause::Notice, DownCause::Deadline, DownCause::HostLost]
                     .into_iter()
                     .find(|c| c.name() == *cause)?,
             }),
@@ -195,6 +198,11 @@ mod tests {
                 tick: 51,
                 robot: 3,
                 cause: DownCause::Deadline,
+            },
+            WorldReport::Down {
+                tick: 52,
+                robot: 4,
+                cause: DownCause::HostLost,
             },
             WorldReport::Up { tick: 80, robot: 3 },
             WorldReport::Await { tick: 50 },

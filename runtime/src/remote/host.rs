@@ -4,7 +4,9 @@
 //! a local lockstep run: its own iceoryx2 prefix and root, one `robot-agent` process per robot (told its run-wide
 //! id for its random stream and profile, and its local slot in this host's transport). Per tick it takes the
 //! newest frames message of its share, runs one local tick with those frames, and publishes its robots' replies.
-//! An agent that dies is reported `Dead` from then on (the same semantics as a single-host run). When the world's
+//! An agent that dies is reported `Dead` from then on (the same semantics as a single-host run). Between ticks the
+//! world may send fault orders for the share's agents ([`Order`]): kill, freeze, thaw, stop or start waiting for
+//! one, or replace one with an agent that resumes from the world's record. When the world's
 //! liveliness token goes (the run ended or the world died) or a new assignment arrives (the host rejoined), the
 //! share is stopped: agents are told to end, then killed, and every shared-memory file is removed.
 //!
@@ -27,6 +29,7 @@ use zenoh::sample::SampleKind;
 
 use super::assignment::{Assignment, AssignmentReply};
 use super::codec::{self, Header, Kind, Reply};
+use super::orders::{Order, OrderAction, OrderReply};
 use super::session::{ZenohOptions, zenoh_error};
 use super::{RemoteError, keys};
 use crate::launcher::binaries::Binaries;
@@ -34,7 +37,7 @@ use crate::launcher::children::{self, Children};
 use crate::launcher::process_args::{AgentArgs, RunArgs};
 use crate::launcher::resume::ResumePoint;
 use crate::launcher::run_dir;
-use crate::messages::SensorFrame;
+use crate::messages::{SensorFrame, SupervisorSnapshot};
 use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink};
 
 /// How long agents get to exit by themselves when a share ends.
@@ -43,6 +46,8 @@ const AGENT_EXIT_GRACE: Duration = Duration::from_secs(2);
 const IDLE_PERIOD: Duration = Duration::from_millis(50);
 /// Lines of an agent's log quoted when it fails to start.
 const LOG_LINES_QUOTED: usize = 8;
+/// How often a replacement agent's join is looked at.
+const REPLACEMENT_POLL: Duration = Duration::from_millis(5);
 
 /// What `swarm host` was asked to do.
 #[derive(Debug, Clone)]
@@ -65,6 +70,8 @@ pub struct HostOptions {
 enum Event {
     /// A new share.
     Assign(Query),
+    /// A fault order for one of the share's agents.
+    Order(Query),
     /// A frames message of run `run`.
     Frames { run: u64, bytes: Vec<u8> },
     /// The world of run `run` is gone.
@@ -105,6 +112,14 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
         })
         .wait()
         .map_err(zenoh_error("declaring the assignment queryable"))?;
+    let order_sender = sender.clone();
+    let _orders: Queryable<()> = session
+        .declare_queryable(keys::orders(&options.name))
+        .callback(move |query| {
+            let _ = order_sender.send(Event::Order(query));
+        })
+        .wait()
+        .map_err(zenoh_error("declaring the orders queryable"))?;
     let kill_sender = sender.clone();
     let _kill: Subscriber<()> = session
         .declare_subscriber(keys::kill(&options.name))
@@ -145,6 +160,7 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
                 drop(share.take());
                 share = accept(&session, options, &binaries, &query, &sender);
             }
+            Some(Event::Order(query)) => answer_order(&query, share.as_mut(), options.max_payload),
             Some(Event::Frames { run, bytes }) => {
                 if let Some(current) = share.as_mut().filter(|s| s.assignment.run == run) {
                     let newest = newest_frames(&events, &sender, run, bytes, &mut current.dropped);
@@ -289,6 +305,49 @@ fn accept(
     share
 }
 
+/// Answers a fault order: carried out by the current share if the order is for it, refused otherwise.
+fn answer_order(query: &Query, share: Option<&mut Share>, max_payload: usize) {
+    let order = match query.payload() {
+        Some(payload) => codec::decode_message::<Order>(&payload.to_bytes(), max_payload),
+        None => Err(codec::WireError::Malformed(
+            "an order without payload".into(),
+        )),
+    };
+    let reply = match (order, share) {
+        (Err(e), _) => {
+            tracing::warn!("refusing a malformed order: {e}");
+            OrderReply::Failed {
+                reason: format!("malformed order: {e}"),
+            }
+        }
+        (Ok(order), Some(share))
+            if order.run == share.assignment.run && order.epoch == share.assignment.epoch =>
+        {
+            match share.carry_out(order.robot, order.action) {
+                Ok(()) => OrderReply::Done,
+                Err(reason) => {
+                    tracing::warn!(robot = order.robot, "order not carried out: {reason}");
+                    OrderReply::Failed { reason }
+                }
+            }
+        }
+        (Ok(order), _) => OrderReply::Failed {
+            reason: format!(
+                "no share of run {:016x} epoch {} on this host",
+                order.run, order.epoch
+            ),
+        },
+    };
+    match codec::encode_message(&reply) {
+        Ok(bytes) => {
+            if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {
+                tracing::warn!("answering an order: {e}");
+            }
+        }
+        Err(e) => tracing::warn!("encoding an order's answer: {e}"),
+    }
+}
+
 /// One run's share on this host.
 struct Share {
     assignment: Assignment,
@@ -296,6 +355,11 @@ struct Share {
     spec: RunSpec,
     link: Option<WorldLink>,
     children: Children,
+    /// Per slot: its agent process ended (killed or exited) and no replacement has joined since.
+    exited: Vec<bool>,
+    /// The robot-agent program and the folder of the agents' logs, for replacements.
+    agent: PathBuf,
+    logs: PathBuf,
     frames: Vec<SensorFrame>,
     replies: Vec<Reply>,
     buf: Vec<u8>,
@@ -381,16 +445,16 @@ impl Share {
             spec,
             link: Some(link),
             children: Children::default(),
+            exited: vec![false; count as usize],
+            agent: binaries.agent.clone(),
+            logs: options.logs.clone(),
             publisher,
             _frames: frames,
             _world: world,
             assignment,
         };
-        share.spawn_agents(&binaries.agent, &options.logs)?;
-        share.wait_joined(
-            Duration::from_millis(share.assignment.join_timeout_ms),
-            &options.logs,
-        )?;
+        share.spawn_agents()?;
+        share.wait_joined(Duration::from_millis(share.assignment.join_timeout_ms))?;
         tracing::info!(
             run = format!("{run:016x}"),
             epoch = share.assignment.epoch,
@@ -400,43 +464,144 @@ impl Share {
         Ok(share)
     }
 
-    fn spawn_agents(&mut self, agent: &Path, logs: &Path) -> Result<(), RemoteError> {
-        let run = RunArgs {
-            run: self.spec.name().to_owned(),
-            iox_root: self.spec.root_dir().to_path_buf(),
-        };
-        let resume = self.write_resume_points(logs)?;
-        for (slot, (robot, controller)) in self.assignment.robots.iter().enumerate() {
-            let args = AgentArgs {
-                run: run.clone(),
-                robot: *robot,
-                config: self.assignment.config.clone(),
-                controller: controller.clone(),
-                seed: self.assignment.seed,
-                robots: self.assignment.robots_override,
-                compiled_supervisors: None,
-                resume: resume.get(slot).cloned(),
-            };
-            let log_path = log_file(logs, *robot);
-            let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
-                what: format!("creating {}", log_path.display()),
-                source,
-            })?;
-            let child = children::spawn(
-                Command::new(agent)
-                    .args(args.to_args())
-                    .args(["--slot", &slot.to_string()])
-                    .stdin(Stdio::null())
-                    .stdout(Stdio::null())
-                    .stderr(log),
-            )
-            .map_err(|source| RemoteError::Io {
-                what: format!("starting {}", agent.display()),
-                source,
-            })?;
+    /// Starts one agent per robot of the share (resuming from the world's record when the host rejoins).
+    fn spawn_agents(&mut self) -> Result<(), RemoteError> {
+        let resume = self.write_resume_points()?;
+        for slot in 0..self.robots.len() {
+            let child = self.spawn_agent(slot, resume.get(slot).cloned())?;
             self.children.agents.push(Some(child));
         }
         Ok(())
+    }
+
+    /// Starts the agent of `slot`, resuming from the point in `resume` if given.
+    fn spawn_agent(
+        &self,
+        slot: usize,
+        resume: Option<PathBuf>,
+    ) -> Result<std::process::Child, RemoteError> {
+        let (robot, controller) = &self.assignment.robots[slot];
+        let args = AgentArgs {
+            run: RunArgs {
+                run: self.spec.name().to_owned(),
+                iox_root: self.spec.root_dir().to_path_buf(),
+            },
+            robot: *robot,
+            config: self.assignment.config.clone(),
+            controller: controller.clone(),
+            seed: self.assignment.seed,
+            robots: self.assignment.robots_override,
+            compiled_supervisors: None,
+            resume,
+        };
+        let log_path = log_file(&self.logs, *robot);
+        let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
+            what: format!("creating {}", log_path.display()),
+            source,
+        })?;
+        children::spawn(
+            Command::new(&self.agent)
+                .args(args.to_args())
+                .args(["--slot", &slot.to_string()])
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(log),
+        )
+        .map_err(|source| RemoteError::Io {
+            what: format!("starting {}", self.agent.display()),
+            source,
+        })
+    }
+
+    /// Carries out a fault order for robot `robot` of the share; the reason when it cannot be.
+    fn carry_out(&mut self, robot: u32, action: OrderAction) -> Result<(), String> {
+        let slot = self
+            .robots
+            .iter()
+            .position(|&r| r == robot)
+            .ok_or_else(|| format!("robot {robot} is not in this host's share"))?;
+        let slot_id = slot as u32;
+        let link = self.link.as_ref().ok_or("the share is ending")?;
+        let agent = self.children.agents.get(slot).and_then(Option::as_ref);
+        match action {
+            OrderAction::Kill => {
+                self.children.kill_agent(slot_id);
+                self.exited[slot] = true;
+                link.mark_dead(slot_id).map_err(|e| e.to_string())
+            }
+            OrderAction::Freeze => {
+                let agent = agent.ok_or_else(|| format!("robot {robot} has no running agent"))?;
+                children::signal(agent, nix::sys::signal::Signal::SIGSTOP);
+                link.mark_dead(slot_id).map_err(|e| e.to_string())
+            }
+            OrderAction::Thaw => {
+                let agent = agent.ok_or_else(|| format!("robot {robot}'s agent is gone"))?;
+                children::signal(agent, nix::sys::signal::Signal::SIGCONT);
+                revive(link, slot_id, robot)
+            }
+            OrderAction::Skip => link.mark_dead(slot_id).map_err(|e| e.to_string()),
+            OrderAction::Revive => revive(link, slot_id, robot),
+            OrderAction::Respawn { tick, snapshot } => self.replace(slot, tick, *snapshot),
+        }
+    }
+
+    /// Replaces the agent of `slot` with one that resumes from `snapshot` (of tick `tick`); returns once it joined.
+    fn replace(
+        &mut self,
+        slot: usize,
+        tick: u64,
+        snapshot: SupervisorSnapshot,
+    ) -> Result<(), String> {
+        let robot = self.robots[slot];
+        self.children.kill_agent(slot as u32);
+        self.exited[slot] = true;
+        let link = self.link.as_ref().ok_or("the share is ending")?;
+        link.mark_dead(slot as u32).map_err(|e| e.to_string())?;
+        let point = ResumePoint {
+            robot,
+            tick,
+            snapshot,
+        }
+        .write(&self.logs)
+        .map_err(|e| e.to_string())?;
+        let child = self
+            .spawn_agent(slot, Some(point))
+            .map_err(|e| e.to_string())?;
+        tracing::info!(robot, pid = child.id(), "replacing the robot's agent");
+        self.children.agents[slot] = Some(child);
+        let deadline = Instant::now() + Duration::from_millis(self.assignment.join_timeout_ms);
+        loop {
+            let Some(link) = self.link.as_mut() else {
+                return Err("the share is ending".into());
+            };
+            // Serves the replacement's request for a fresh command board while waiting.
+            let _ = link.wait_for_agents(REPLACEMENT_POLL);
+            if link.agent_present(slot as u32) {
+                self.exited[slot] = false;
+                return Ok(());
+            }
+            if let Some(failure) = self.failed_start(|s| s == slot) {
+                return Err(failure);
+            }
+            if Instant::now() >= deadline {
+                return Err(format!(
+                    "robot {robot}'s replacement agent did not join within {} ms",
+                    self.assignment.join_timeout_ms
+                ));
+            }
+        }
+    }
+
+    /// If one of `slots`' agents exited (others that exited are reaped as deaths): which robot, how, and the end
+    /// of its log.
+    fn failed_start(&mut self, slots: impl Fn(usize) -> bool) -> Option<String> {
+        let (slot, status) = self
+            .reap()
+            .into_iter()
+            .find(|(slot, _)| slots(*slot as usize))?;
+        let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
+        let log = run_dir::tail(&log_file(&self.logs, robot), LOG_LINES_QUOTED);
+        Some(format!("robot {robot} failed to start ({status}):\n{log}"))
     }
 
     /// Whether this tick had live robots and every one of them answered (so each has stepped its controller).
@@ -452,7 +617,7 @@ impl Share {
 
     /// Writes a rejoining share's resume points (`<logs>/resume/robot-<id>.json`, as in a run directory) and
     /// returns them in slot order; none on a first assignment.
-    fn write_resume_points(&self, logs: &Path) -> Result<Vec<PathBuf>, RemoteError> {
+    fn write_resume_points(&self) -> Result<Vec<PathBuf>, RemoteError> {
         let robots = self.assignment.robots.iter().map(|(id, _)| *id);
         robots
             .zip(&self.assignment.resume)
@@ -462,13 +627,13 @@ impl Share {
                     tick,
                     snapshot,
                 };
-                Ok(point.write(logs)?)
+                Ok(point.write(&self.logs)?)
             })
             .collect()
     }
 
     /// Waits for every agent to join; an agent that exits first fails the share with the end of its log.
-    fn wait_joined(&mut self, timeout: Duration, logs: &Path) -> Result<(), RemoteError> {
+    fn wait_joined(&mut self, timeout: Duration) -> Result<(), RemoteError> {
         let deadline = Instant::now() + timeout;
         loop {
             let Some(link) = &mut self.link else {
@@ -479,27 +644,29 @@ impl Share {
                 Err(e) if Instant::now() >= deadline => return Err(e.into()),
                 Err(_) => {}
             }
-            if let Some((slot, status)) = self.children.reap_agents().into_iter().next() {
-                let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
-                let log = run_dir::tail(&log_file(logs, robot), LOG_LINES_QUOTED);
+            if let Some(reason) = self.failed_start(|_| true) {
                 return Err(RemoteError::Refused {
                     host: self.assignment.name.clone(),
-                    reason: format!("robot {robot} failed to start ({status}):\n{log}"),
+                    reason,
                 });
             }
         }
     }
 
-    /// Reports agents that exited to the local transport, so their robots are `Dead` from now on.
-    fn reap(&mut self) {
-        let Some(link) = &self.link else { return };
-        for (slot, status) in self.children.reap_agents() {
+    /// Reports agents that exited to the local transport, so their robots are `Dead` from now on; returns them.
+    fn reap(&mut self) -> Vec<(u32, std::process::ExitStatus)> {
+        let exits = self.children.reap_agents();
+        for &(slot, status) in &exits {
             let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
             tracing::warn!(robot, %status, "robot agent died");
-            if let Err(e) = link.mark_dead(slot) {
+            self.exited[slot as usize] = true;
+            if let Some(link) = &self.link
+                && let Err(e) = link.mark_dead(slot)
+            {
                 tracing::warn!(robot, "reporting the death: {e}");
             }
         }
+        exits
     }
 
     /// Runs one local tick with a frames message and publishes the replies.
@@ -527,6 +694,7 @@ impl Share {
             return Ok(());
         }
         self.reap();
+        let exited = &self.exited;
         let Some(link) = self.link.as_mut() else {
             return Ok(());
         };
@@ -534,6 +702,7 @@ impl Share {
         link.start_at(header.tick);
         link.tick_with(|_, local| local.copy_from_slice(frames))?;
         for (slot, reply) in self.replies.iter_mut().enumerate() {
+            // `Dead` means the process ended: an agent the world froze or stopped waiting for is `Missing`.
             *reply = match (link.statuses()[slot], link.command(slot as u32)) {
                 (CommandStatus::Answered, Some(command)) => {
                     let mut command = *command;
@@ -541,7 +710,7 @@ impl Share {
                     command.tick = header.tick;
                     Reply::Answered(command)
                 }
-                (CommandStatus::Dead, _) => Reply::Dead,
+                _ if exited[slot] => Reply::Dead,
                 _ => Reply::Missing,
             };
         }
@@ -588,6 +757,15 @@ impl Drop for Share {
             malformed = self.dropped.malformed,
             "share ended"
         );
+    }
+}
+
+/// Ticks wait for the agent of `slot` (robot `robot`) again; fails when its agent is no longer connected.
+fn revive(link: &WorldLink, slot: u32, robot: u32) -> Result<(), String> {
+    if link.revive(slot) {
+        Ok(())
+    } else {
+        Err(format!("robot {robot}'s agent is no longer connected"))
     }
 }
 

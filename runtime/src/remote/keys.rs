@@ -2,6 +2,7 @@
 //!
 //! - `swarm/hosts/<host>`: a host daemon's liveliness token (it is up and reachable).
 //! - `swarm/hosts/<host>/assign`: the host's queryable; the world sends it its share of a run.
+//! - `swarm/hosts/<host>/orders`: the host's queryable for fault orders on its robots' agents.
 //! - `swarm/hosts/<host>/kill`: `swarm ctl kill-host`; the payload names the run (8 bytes, little-endian).
 //! - `swarm/runs/<run>/world`: the world's liveliness token while the run lasts (hosts end their share when it goes).
 //! - `swarm/runs/<run>/frames/<host>` and `swarm/runs/<run>/replies/<host>`: one message per host per tick each way.
@@ -43,6 +44,11 @@ pub fn host_of_token(key: &str) -> Option<&str> {
 /// Queryable through which host `name` receives its share of a run.
 pub fn assign(name: &str) -> String {
     format!("swarm/hosts/{name}/assign")
+}
+
+/// Queryable through which host `name` receives fault orders for its robots' agents.
+pub fn orders(name: &str) -> String {
+    format!("swarm/hosts/{name}/orders")
 }
 
 /// Where the world of a run tells host `name` to die (`swarm ctl kill-host`).

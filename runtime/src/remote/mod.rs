@@ -3,8 +3,9 @@
 //! Each host daemon ([`host`]) announces itself with a zenoh liveliness token, receives its share of a run
 //! ([`assignment`]), runs it as a local lockstep run (its own iceoryx2 prefix and root, one agent process per
 //! robot) and bridges: per tick one message of its robots' frames in, one message of their replies out
-//! ([`codec`]). The world's side ([`world_bridge`]) publishes one batch per host per tick, waits for each host's
-//! batch with the tick deadline, and treats the robots of a lost host as dead from the tick it notices the loss.
+//! ([`codec`]); between ticks the world may send it fault orders for its robots' agents ([`orders`]). The
+//! world's side ([`world_bridge`]) publishes one batch per host per tick, waits for each host's batch with the
+//! tick deadline, and treats the robots of a lost host as dead from the tick it notices the loss.
 //! Key expressions are in [`keys`], session settings in [`session`]. docs/hosts.md explains the choices.
 //!
 //! A run with every robot local never opens a zenoh session.
@@ -13,6 +14,7 @@ pub mod assignment;
 pub mod codec;
 pub mod host;
 pub mod keys;
+pub mod orders;
 pub mod session;
 pub mod world_bridge;
 

@@ -7,6 +7,8 @@
 //! *lost* at the tick the world processes that news, and its robots are dead from that tick on; the tick is
 //! recorded. A lost host whose token comes back gets its share again (a new epoch, so its old messages are
 //! stale) and its robots come back to life at the tick it answers the assignment, with freshly started agents.
+//! Between ticks the world's fault driver sends hosts fault orders ([`RemoteHosts::order`]) and learns of agents
+//! that died on a host and of hosts lost and back ([`RemoteHosts::take_news`]).
 //!
 //! It must never stall: every wait is bounded by the tick deadline, and a malformed, oversized or stale payload is
 //! dropped and counted.
@@ -23,6 +25,7 @@ use zenoh::{Session, Wait};
 
 use super::assignment::{Assignment, AssignmentReply};
 use super::codec::{self, Header, Kind, Reply};
+use super::orders::{Order, OrderAction, OrderReply};
 use super::session::{ZenohOptions, zenoh_error};
 use super::{RemoteError, keys};
 use crate::messages::{ActuatorCommand, SensorFrame};
@@ -80,6 +83,17 @@ pub enum HostEvent {
     },
 }
 
+/// What the fault driver learns of the robots on hosts, besides their replies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RobotNews {
+    /// The robot's agent process ended on its host (not by an order).
+    Died(u32),
+    /// The robot's host was lost.
+    HostLost(u32),
+    /// The robot's host rejoined and started a fresh agent for it.
+    HostBack(u32),
+}
+
 /// Counters of rejected payloads.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Dropped {
@@ -97,6 +111,22 @@ enum Incoming {
     Assigned(usize, Result<Vec<u8>, String>),
     /// The assignment query of (host, epoch) finished (after its answer, if any).
     AssignEnded(usize, u32),
+    /// The answer to order number `n`.
+    Ordered(u64, Result<Vec<u8>, String>),
+    /// Order number `n` finished (after its answer, if any).
+    OrderEnded(u64),
+}
+
+/// Says when an order query is finished.
+struct OrderGuard {
+    sender: Sender<Incoming>,
+    order: u64,
+}
+
+impl Drop for OrderGuard {
+    fn drop(&mut self) {
+        let _ = self.sender.send(Incoming::OrderEnded(self.order));
+    }
 }
 
 /// Says when an assignment query is finished: zenoh drops the reply callback, and this with it.
@@ -134,6 +164,8 @@ struct Host {
     answered: u64,
     /// The first tick it runs (after joining or rejoining).
     live_from: u64,
+    /// It rejoined and its robots' return is still to be told (at the end of tick `live_from`).
+    returning: bool,
     replies: Vec<Reply>,
     publisher: Publisher<'static>,
     events: Vec<HostEvent>,
@@ -154,8 +186,16 @@ pub struct RemoteHosts {
     frames: Vec<SensorFrame>,
     commands: Vec<ActuatorCommand>,
     status: Vec<CommandStatus>,
-    alive: Vec<bool>,
-    changes: Vec<(u32, bool)>,
+    /// Index in `hosts` of each robot's host.
+    owner: Vec<usize>,
+    /// Per robot: its host runs an agent for it, as far as the world knows.
+    present: Vec<bool>,
+    /// Per robot: an order made its host stop waiting for it (killed, frozen, missed a deadline).
+    held: Vec<bool>,
+    news: Vec<RobotNews>,
+    /// Orders sent so far; the answers of the one waited for are in `answer`.
+    orders_sent: u64,
+    answer: Option<Result<Vec<u8>, String>>,
     buf: Vec<u8>,
     dropped: Dropped,
     _token: LivelinessToken,
@@ -225,11 +265,20 @@ impl RemoteHosts {
                 epoch: 0,
                 answered: 0,
                 live_from: 1,
+                returning: false,
                 publisher,
                 events: Vec::new(),
             });
         }
         let n = robots as usize;
+        let mut owner = vec![0; n];
+        for (index, share) in options.hosts.iter().enumerate() {
+            for &robot in &share.robots {
+                if let Some(slot) = owner.get_mut(robot as usize) {
+                    *slot = index;
+                }
+            }
+        }
         Ok(RemoteHosts {
             options,
             session,
@@ -242,8 +291,12 @@ impl RemoteHosts {
             frames: (0..robots).map(SensorFrame::empty).collect(),
             commands: (0..robots).map(|r| ActuatorCommand::idle(r, 0)).collect(),
             status: vec![CommandStatus::Missing; n],
-            alive: vec![true; n],
-            changes: Vec::new(),
+            owner,
+            present: vec![true; n],
+            held: vec![false; n],
+            news: Vec::new(),
+            orders_sent: 0,
+            answer: None,
             buf: Vec::new(),
             dropped: Dropped::default(),
             _token: token,
@@ -389,8 +442,14 @@ impl RemoteHosts {
             missing: 0,
             dead: 0,
         };
-        for host in &self.hosts {
+        for host in &mut self.hosts {
             let live = host.state == State::Live && host.live_from <= tick;
+            if live && host.returning {
+                // Its robots take part from the next tick, as after any return the world learns of in a tick.
+                host.returning = false;
+                self.news
+                    .extend(host.share.robots.iter().map(|&r| RobotNews::HostBack(r)));
+            }
             for (slot, &robot) in host.share.robots.iter().enumerate() {
                 let r = robot as usize;
                 let status = match (live, host.answered == tick, host.replies[slot]) {
@@ -398,15 +457,17 @@ impl RemoteHosts {
                         self.commands[r] = command;
                         CommandStatus::Answered
                     }
+                    (true, true, Reply::Dead) => {
+                        if std::mem::replace(&mut self.present[r], false) {
+                            self.news.push(RobotNews::Died(robot));
+                        }
+                        CommandStatus::Dead
+                    }
+                    (true, _, _) if self.held[r] => CommandStatus::Dead,
                     (true, true, Reply::Missing) | (true, false, _) => CommandStatus::Missing,
-                    (true, true, Reply::Dead) | (false, _, _) => CommandStatus::Dead,
+                    (false, _, _) => CommandStatus::Dead,
                 };
                 self.status[r] = status;
-                let alive = status != CommandStatus::Dead;
-                if self.alive[r] != alive {
-                    self.alive[r] = alive;
-                    self.changes.push((robot, alive));
-                }
                 match status {
                     CommandStatus::Answered => outcome.answered += 1,
                     CommandStatus::Missing => outcome.missing += 1,
@@ -439,8 +500,14 @@ impl RemoteHosts {
                     host.state = State::Absent;
                 } else if host.state == State::Live {
                     host.state = State::Absent;
+                    host.returning = false;
                     host.events.push(HostEvent::Lost { tick });
                     tracing::warn!(host = name, tick, "host lost: its robots are dead");
+                    for &robot in &host.share.robots {
+                        self.present[robot as usize] = false;
+                        self.held[robot as usize] = false;
+                        self.news.push(RobotNews::HostLost(robot));
+                    }
                 }
             }
             Incoming::Assigned(index, answer) => self.assigned(index, answer, before_run)?,
@@ -455,6 +522,13 @@ impl RemoteHosts {
                 }
             }
             Incoming::Replies(name, bytes) => self.replies(&name, &bytes),
+            Incoming::Ordered(order, answer) if order == self.orders_sent => {
+                self.answer = Some(answer);
+            }
+            Incoming::OrderEnded(order) if order == self.orders_sent && self.answer.is_none() => {
+                self.answer = Some(Err("no answer".into()));
+            }
+            Incoming::Ordered(..) | Incoming::OrderEnded(_) => {}
         }
         Ok(())
     }
@@ -561,6 +635,11 @@ impl RemoteHosts {
                 } else {
                     self.tick.max(1)
                 };
+                for &robot in &host.share.robots {
+                    self.present[robot as usize] = true;
+                    self.held[robot as usize] = false;
+                }
+                host.returning = !before_run;
                 if !before_run {
                     host.events.push(HostEvent::Rejoined {
                         tick: host.live_from,
@@ -668,9 +747,110 @@ impl RemoteHosts {
         &self.status
     }
 
-    /// Robots whose life changed in the last ticks (`false`: dead, `true`: back), oldest first; drains the list.
-    pub fn take_changes(&mut self) -> std::vec::Drain<'_, (u32, bool)> {
-        self.changes.drain(..)
+    /// What happened to robots' agents and hosts since the last call, oldest first; drains the list.
+    pub fn take_news(&mut self) -> std::vec::Drain<'_, RobotNews> {
+        self.news.drain(..)
+    }
+
+    /// Whether `robot`'s host runs an agent for it, as far as the world knows.
+    pub fn agent_present(&self, robot: u32) -> bool {
+        self.present.get(robot as usize) == Some(&true)
+            && self.hosts[self.owner[robot as usize]].state == State::Live
+    }
+
+    /// Sends `robot`'s host a fault order and waits for the answer (a replacement agent's join included), while
+    /// following the hosts' news: `Ok(true)` when carried out, `Ok(false)` when the host is not live, is lost
+    /// meanwhile, does not answer in time or cannot carry it out (logged). Never waits past the host's loss.
+    pub fn order(&mut self, robot: u32, action: OrderAction) -> Result<bool, RemoteError> {
+        let Some(&index) = self.owner.get(robot as usize) else {
+            return Ok(false);
+        };
+        if self.hosts[index].state != State::Live {
+            return Ok(false);
+        }
+        let name = self.hosts[index].share.name.clone();
+        let epoch = self.hosts[index].epoch;
+        let timeout = match action {
+            OrderAction::Respawn { .. } => self.options.join_timeout + Duration::from_secs(5),
+            _ => self.options.tick_deadline.max(Duration::from_secs(5)),
+        };
+        let order = Order {
+            run: self.run,
+            epoch,
+            robot,
+            action: action.clone(),
+        };
+        let payload = codec::encode_message(&order)?;
+        self.orders_sent += 1;
+        self.answer = None;
+        let number = self.orders_sent;
+        let sender = self.sender.clone();
+        let ended = OrderGuard {
+            sender: self.sender.clone(),
+            order: number,
+        };
+        self.session
+            .get(keys::orders(&name))
+            .payload(payload)
+            .timeout(timeout)
+            .callback(move |reply| {
+                let _ = &ended;
+                let answer = match reply.result() {
+                    Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
+                    Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
+                };
+                let _ = sender.send(Incoming::Ordered(number, answer));
+            })
+            .wait()
+            .map_err(zenoh_error("sending a host a fault order"))?;
+        let deadline = Instant::now() + timeout;
+        while self.answer.is_none() {
+            let now = Instant::now();
+            if now >= deadline
+                || self.hosts[index].state != State::Live
+                || epoch != self.hosts[index].epoch
+            {
+                break;
+            }
+            match self.incoming.recv_timeout(deadline - now) {
+                Ok(event) => self.handle(event, false)?,
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
+        }
+        let outcome = match self.answer.take() {
+            None => Err("the host was lost or did not answer in time".to_owned()),
+            Some(answer) => answer
+                .and_then(|bytes| {
+                    codec::decode_message::<OrderReply>(&bytes, self.options.max_payload).map_err(
+                        |e| {
+                            self.dropped.rejected += 1;
+                            e.to_string()
+                        },
+                    )
+                })
+                .and_then(|reply| match reply {
+                    OrderReply::Done => Ok(()),
+                    OrderReply::Failed { reason } => Err(reason),
+                }),
+        };
+        if let Err(reason) = outcome {
+            tracing::warn!(
+                host = name,
+                robot,
+                order = action.name(),
+                "fault order not carried out: {reason}"
+            );
+            return Ok(false);
+        }
+        let r = robot as usize;
+        match action {
+            OrderAction::Kill => (self.present[r], self.held[r]) = (false, true),
+            OrderAction::Freeze | OrderAction::Skip => self.held[r] = true,
+            OrderAction::Thaw | OrderAction::Revive => self.held[r] = false,
+            OrderAction::Respawn { .. } => (self.present[r], self.held[r]) = (true, false),
+        }
+        Ok(true)
     }
 
     /// Each host with what happened to it.
@@ -916,8 +1096,9 @@ mod tests {
             }
         }
         let lost_at = lost_at.expect("the host was declared lost");
-        let changes: Vec<(u32, bool)> = world.take_changes().collect();
-        assert_eq!(changes, [(1, false), (2, false)]);
+        let news: Vec<RobotNews> = world.take_news().collect();
+        assert_eq!(news, [RobotNews::HostLost(1), RobotNews::HostLost(2)]);
+        assert!(!world.agent_present(1) && world.agent_present(0));
         let events: Vec<HostEvent> = world
             .host_events()
             .find(|(share, _)| share.name == "goes")

@@ -15,7 +15,12 @@
 //! Every robot marked dead gets a resume point (its last recorded supervisor snapshot) before the launcher hears
 //! of it, so a replacement agent can continue from it. A dead robot stays in the arena as an inert body with its
 //! LEDs off; its frame says `alive = 0`, and anything its agent sends is ignored until it is back.
-//! This module never signals a process: the launcher does that.
+//! This module never signals a process: the launcher does that for local agents, and for robots on hosts the
+//! [`Link`] turns each step into a fault order to the robot's host. There the deaths come from the hosts (an
+//! agent that ended, a host lost) instead of the launcher's notices, and the launcher's `respawn r` lines
+//! become replacement agents on the robot's host. A robot whose host is lost is down until the host is back
+//! (whatever its restart policy: the host's return restarts its whole share); a robot that was already dead for
+//! good stays dead, its fresh agent on the returning host killed again.
 
 use std::io::BufRead;
 use std::path::PathBuf;
@@ -28,12 +33,14 @@ use swarm_runtime::launcher::faults::{FaultAction, FaultPlan};
 use swarm_runtime::launcher::resume::ResumePoint;
 use swarm_runtime::launcher::world_control::WorldCommand;
 use swarm_runtime::launcher::world_report::{DownCause, WorldReport};
-use swarm_runtime::messages::ActuatorCommand;
-use swarm_runtime::transport::{CommandStatus, DeathNotices, WorldLink};
+use swarm_runtime::messages::{ActuatorCommand, SupervisorSnapshot};
+use swarm_runtime::remote::world_bridge::RobotNews;
+use swarm_runtime::transport::{CommandStatus, DeathNotices};
 use swarm_world::World;
 use swarm_world::entities::RobotId;
 
 use crate::events::EventsWriter;
+use crate::remote::{Link, Stop};
 use crate::report;
 
 /// How long the world waits for the launcher to apply the faults of a tick.
@@ -52,6 +59,8 @@ enum Down {
     Deadline,
     /// Frozen by the schedule.
     Frozen,
+    /// Its host was lost (back when the host is).
+    HostLost,
 }
 
 /// A robot as the world sees it.
@@ -72,6 +81,15 @@ pub struct FaultDriver {
     commands: Receiver<WorldCommand>,
     notices: Vec<u32>,
     applied: Vec<u64>,
+    /// Robots the launcher replaces (`respawn r`: robots on hosts), in order.
+    respawns: Vec<u32>,
+    /// Robots whose replacement could not start because their host was away: its return brings one.
+    respawn_pending: Vec<bool>,
+    /// Each robot's snapshot (and its tick) from when it was last marked dead, for its replacement.
+    resume: Vec<(u64, SupervisorSnapshot)>,
+    news: Vec<RobotNews>,
+    /// `swarm ctl kill-host` requests (host indices).
+    host_kills: Vec<u32>,
     /// Scratch: the faults due now and the live-robot mask for random picks.
     due: Vec<FaultAction>,
     alive_mask: Vec<bool>,
@@ -110,7 +128,7 @@ impl FaultDriver {
     /// can join: every robot starts without an agent in the transport (a death notice each), so a robot counts
     /// as present only once its agent has connected, not merely claimed its slot.
     pub fn new(
-        link: &WorldLink,
+        link: &mut Link,
         schedule: &FaultSchedule,
         ticks_per_second: u32,
         seed: u64,
@@ -118,9 +136,11 @@ impl FaultDriver {
         out_dir: PathBuf,
         join_timeout: Duration,
     ) -> anyhow::Result<FaultDriver> {
-        let robots = link.config().robots as usize;
-        for robot in 0..robots as u32 {
-            link.mark_dead(robot)?;
+        let robots = link.robots();
+        if let Link::Local(local) = link {
+            for robot in 0..robots as u32 {
+                local.mark_dead(robot)?;
+            }
         }
         let mut plan = FaultPlan::new(schedule, ticks_per_second, seed);
         let mut due = Vec::new();
@@ -139,6 +159,11 @@ impl FaultDriver {
             commands,
             notices: Vec::new(),
             applied: Vec::new(),
+            respawns: Vec::new(),
+            respawn_pending: vec![false; robots],
+            resume: vec![(0, SupervisorSnapshot::default()); robots],
+            news: Vec::new(),
+            host_kills: Vec::new(),
             due,
             alive_mask: vec![true; robots],
             out_dir,
@@ -156,15 +181,37 @@ impl FaultDriver {
         self.robots.iter().filter(|r| **r == Robot::Alive).count()
     }
 
-    /// Waits until every robot has an agent, except those killed at start-up, whose death notices must have
-    /// arrived (so a start-up kill takes effect before tick 1 in every run).
+    /// Waits until every robot has an agent, except those killed at start-up. Locally the launcher kills those
+    /// and their death notices must have arrived; on hosts the world has their hosts kill them, as faults of
+    /// tick 0 the launcher applies (deciding their restarts). Either way a start-up kill takes effect before
+    /// tick 1 in every run.
     pub fn wait_for_agents(
         &mut self,
-        link: &mut WorldLink,
+        link: &mut Link,
         world: &mut World,
         events: &mut EventsWriter,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
+        if let Link::Remote(_) = link {
+            link.wait(self.join_timeout)?;
+            for robot in self.startup_kills.clone() {
+                link.stop(robot, Stop::Kill)?;
+                self.mark_down(robot, Down::Killed, 0, world, events, commands)?;
+                events.record_fault(0, robot as usize, "fault:kill")?;
+                report(WorldReport::Fault {
+                    tick: 0,
+                    kind: FaultKind::Kill,
+                    robot: Some(robot),
+                });
+            }
+            if !self.startup_kills.is_empty() {
+                events.flush()?;
+                report(WorldReport::Await { tick: 0 });
+                self.wait_applied(0)?;
+                self.respawn_requested(link)?;
+            }
+            return Ok(());
+        }
         let deadline = Instant::now() + self.join_timeout;
         loop {
             self.drain();
@@ -191,7 +238,7 @@ impl FaultDriver {
                 );
             }
             // Wakes early when an agent joins; notices are polled.
-            let _ = link.wait_for_agents(JOIN_POLL);
+            link.poll_agents(JOIN_POLL);
         }
     }
 
@@ -199,12 +246,17 @@ impl FaultDriver {
     pub fn before_tick(
         &mut self,
         tick: u64,
-        link: &mut WorldLink,
+        link: &mut Link,
         world: &mut World,
         events: &mut EventsWriter,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         self.drain();
+        for host in std::mem::take(&mut self.host_kills) {
+            link.kill_host(host as usize)?;
+        }
+        self.respawn_requested(link)?;
+        self.hosts_news(tick, link, world, events, commands)?;
         for robot in std::mem::take(&mut self.notices) {
             match self.robots[robot as usize] {
                 Robot::Alive => {
@@ -213,7 +265,7 @@ impl FaultDriver {
                 Robot::Down(Down::Deadline | Down::Frozen) => {
                     self.robots[robot as usize] = Robot::Down(Down::Notice);
                 }
-                Robot::Down(Down::Notice | Down::Killed) => continue,
+                Robot::Down(Down::Notice | Down::Killed | Down::HostLost) => continue,
             }
             report(WorldReport::Down {
                 tick,
@@ -226,7 +278,7 @@ impl FaultDriver {
                 let status = link.statuses()[robot as usize];
                 match self.robots[robot as usize] {
                     Robot::Alive if status == CommandStatus::Missing => {
-                        link.mark_dead(robot)?;
+                        link.stop(robot, Stop::Skip)?;
                         self.mark_down(robot, Down::Deadline, tick, world, events, commands)?;
                         report(WorldReport::Down {
                             tick,
@@ -235,7 +287,7 @@ impl FaultDriver {
                         });
                     }
                     Robot::Down(Down::Deadline)
-                        if link.command(robot).is_some() && link.revive(robot) =>
+                        if link.command(robot).is_some() && link.revive(robot, false)? =>
                     {
                         self.mark_up(robot, tick, world, events)?;
                     }
@@ -251,9 +303,10 @@ impl FaultDriver {
             match self.rejoin_at[r] {
                 Some(at) if at > tick => {}
                 Some(at) if at == tick => {
-                    self.wait_for_replacement(robot, link)?;
                     self.rejoin_at[r] = None;
-                    self.mark_up(robot, tick, world, events)?;
+                    if self.wait_for_replacement(robot, link)? {
+                        self.mark_up(robot, tick, world, events)?;
+                    }
                 }
                 _ => {
                     if link.agent_present(robot) {
@@ -266,11 +319,67 @@ impl FaultDriver {
         self.scheduled(tick, link, world, events, commands)
     }
 
+    /// Starts the replacements the launcher asked for (robots on hosts; a local launcher starts its own).
+    fn respawn_requested(&mut self, link: &mut Link) -> anyhow::Result<()> {
+        for robot in std::mem::take(&mut self.respawns) {
+            let (tick, snapshot) = self.resume[robot as usize];
+            let started = link.respawn(robot, tick, snapshot)?;
+            self.respawn_pending[robot as usize] = !started;
+        }
+        Ok(())
+    }
+
+    /// Takes in what the hosts reported: an agent that ended is a death notice; a lost host's robots are down
+    /// until it is back; a returning host's fresh agents take part if their robot was lost with the host or is
+    /// to be restarted, and are killed again if their robot is dead for good.
+    fn hosts_news(
+        &mut self,
+        tick: u64,
+        link: &mut Link,
+        world: &mut World,
+        events: &mut EventsWriter,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
+        link.take_news(&mut self.news);
+        for news in std::mem::take(&mut self.news) {
+            match news {
+                RobotNews::Died(robot) => self.notices.push(robot),
+                RobotNews::HostLost(robot) => {
+                    if matches!(
+                        self.robots[robot as usize],
+                        Robot::Alive | Robot::Down(Down::Frozen | Down::Deadline)
+                    ) {
+                        self.mark_down(robot, Down::HostLost, tick, world, events, commands)?;
+                        report(WorldReport::Down {
+                            tick,
+                            robot,
+                            cause: DownCause::HostLost,
+                        });
+                    }
+                }
+                RobotNews::HostBack(robot) => {
+                    let r = robot as usize;
+                    match self.robots[r] {
+                        Robot::Down(Down::HostLost) => self.mark_up(robot, tick, world, events)?,
+                        Robot::Down(Down::Notice | Down::Killed)
+                            if self.respawn_pending[r] || self.rejoin_at[r].is_some() =>
+                        {
+                            // The fresh agent is the replacement; the restarts below take it in.
+                            self.respawn_pending[r] = false;
+                        }
+                        _ => link.stop(robot, Stop::Kill)?,
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The schedule's faults at `tick`: record, report, wait for the launcher to apply them.
     fn scheduled(
         &mut self,
         tick: u64,
-        link: &WorldLink,
+        link: &mut Link,
         world: &mut World,
         events: &mut EventsWriter,
         commands: &[ActuatorCommand],
@@ -309,16 +418,16 @@ impl FaultDriver {
             }
             match (action.kind, action.robot) {
                 (FaultKind::Kill, Some(robot)) => {
-                    let was_alive = self.robots[robot as usize] == Robot::Alive;
-                    if was_alive {
-                        link.mark_dead(robot)?;
+                    // A frozen robot's agent is killed too (on a host, by its host).
+                    link.stop(robot, Stop::Kill)?;
+                    if self.robots[robot as usize] == Robot::Alive {
                         self.mark_down(robot, Down::Killed, tick, world, events, commands)?;
                     }
                     self.robots[robot as usize] = Robot::Down(Down::Killed);
                     events.record_fault(tick, robot as usize, "fault:kill")?;
                 }
                 (FaultKind::Freeze, Some(robot)) => {
-                    link.mark_dead(robot)?;
+                    link.stop(robot, Stop::Freeze)?;
                     self.mark_down(robot, Down::Frozen, tick, world, events, commands)?;
                     events.record_fault(tick, robot as usize, "fault:freeze")?;
                 }
@@ -339,8 +448,9 @@ impl FaultDriver {
         events.flush()?;
         report(WorldReport::Await { tick });
         self.wait_applied(tick)?;
+        self.respawn_requested(link)?;
         for robot in thawed {
-            if link.revive(robot) {
+            if link.revive(robot, true)? {
                 events.record_fault(tick, robot as usize, "fault:thaw")?;
                 self.mark_up(robot, tick, world, events)?;
             } else {
@@ -367,6 +477,7 @@ impl FaultDriver {
             .get(robot as usize)
             .copied()
             .unwrap_or_else(|| ActuatorCommand::idle(robot, 0));
+        self.resume[robot as usize] = (last.tick, last.supervisors);
         ResumePoint {
             robot,
             tick: last.tick,
@@ -378,6 +489,7 @@ impl FaultDriver {
             Down::Killed | Down::Frozen => return Ok(()),
             Down::Notice => "fault:down",
             Down::Deadline => "fault:missed",
+            Down::HostLost => "fault:host-lost",
         };
         events.record_fault(tick, robot as usize, name)?;
         Ok(())
@@ -398,8 +510,9 @@ impl FaultDriver {
         Ok(())
     }
 
-    /// Holds the tick until a restarted robot's replacement has joined (or the join timeout passes).
-    fn wait_for_replacement(&mut self, robot: u32, link: &mut WorldLink) -> anyhow::Result<()> {
+    /// Holds the tick until a restarted robot's replacement has joined (or the join timeout passes); `false`
+    /// for a robot on a host without one (its host is away or could not start it: the robot stays down).
+    fn wait_for_replacement(&mut self, robot: u32, link: &mut Link) -> anyhow::Result<bool> {
         let deadline = Instant::now() + self.join_timeout;
         while !link.agent_present(robot) {
             if Instant::now() > deadline {
@@ -408,9 +521,15 @@ impl FaultDriver {
                     self.join_timeout
                 );
             }
-            let _ = link.wait_for_agents(JOIN_POLL);
+            if !link.poll_agents(JOIN_POLL) {
+                tracing::warn!(
+                    robot,
+                    "no replacement agent on its host: the robot stays down"
+                );
+                return Ok(false);
+            }
         }
-        Ok(())
+        Ok(true)
     }
 
     /// Takes the launcher's lines that arrived so far.
@@ -429,6 +548,10 @@ impl FaultDriver {
                 self.rejoin_at[robot as usize] = Some(tick);
             }
             WorldCommand::Applied(tick) => self.applied.push(tick),
+            WorldCommand::Respawn(robot) if (robot as usize) < self.robots.len() => {
+                self.respawns.push(robot);
+            }
+            WorldCommand::KillHost(host) => self.host_kills.push(host),
             other => tracing::warn!(?other, "ignoring a launcher line that does not apply here"),
         }
     }

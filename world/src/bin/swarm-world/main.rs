@@ -4,7 +4,8 @@
 //! waits for the agents, then runs the lockstep: sense every robot into the shared frames, wake the agents, wait
 //! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
 //! Progress goes to standard output as [`WorldReport`] lines for the launcher; the launcher's lines on standard
-//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`].
+//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`], the same
+//! way whether the robots run here or on hosts.
 //! SIGINT/SIGTERM end the run after the current tick with every record flushed. Normally started by `swarm run`;
 //! the flags are documented by `swarm-world --help`. With hosts (`--hosts` or `<hosts>`), the robots run on
 //! `swarm host` daemons reached over zenoh instead ([`remote`]).
@@ -101,33 +102,27 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     if let Some(ms) = args.tick_deadline_ms {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
-    // Local agents are supervised through the fault driver; hosts supervise their own agents.
-    let (mut link, mut faults, host_commands) = match HostsPlan::resolve(&args.config, hosts)? {
+    let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
         None => {
             let link = WorldLink::create(&run, link_config)?;
             let launcher = faults::follow_launcher(Some(link.death_notices()));
-            let driver = FaultDriver::new(
-                &link,
-                &schedule,
-                experiment.framework.ticks_per_second,
-                args.seed,
-                launcher,
-                args.out.clone(),
-                Duration::from_millis(args.join_timeout_ms),
-            )?;
-            (Link::Local(link), Some(driver), None)
+            (Link::Local(link), launcher)
         }
         Some(plan) => {
-            anyhow::ensure!(
-                schedule.is_empty(),
-                "{}: fault schedules and restart policies are not supported in multi-host runs yet",
-                args.config.display()
-            );
             let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
             let link = Link::remote(plan, args, controllers, link_config.tick_deadline)?;
-            (link, None, Some(faults::follow_launcher(None)))
+            (link, faults::follow_launcher(None))
         }
     };
+    let mut faults = FaultDriver::new(
+        &mut link,
+        &schedule,
+        experiment.framework.ticks_per_second,
+        args.seed,
+        launcher,
+        args.out.clone(),
+        Duration::from_millis(args.join_timeout_ms),
+    )?;
     let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
     let mut events = EventsWriter::create(&args.out, &roster)?;
     recorder.record_initial(&world)?;
@@ -138,12 +133,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
-    match (&mut faults, &mut link) {
-        (Some(driver), Link::Local(local)) => {
-            driver.wait_for_agents(local, &mut world, &mut events, &commands)?;
-        }
-        _ => link.wait(Duration::from_millis(args.join_timeout_ms))?,
-    }
+    faults.wait_for_agents(&mut link, &mut world, &mut events, &commands)?;
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -156,23 +146,19 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         && !world.is_finished()
         && (args.ticks == 0 || link.tick() < args.ticks)
     {
-        match (&mut faults, &mut link) {
-            (Some(driver), Link::Local(local)) => {
-                driver.before_tick(local.tick() + 1, local, &mut world, &mut events, &commands)?;
-            }
-            _ => {
-                if let Some(commands) = &host_commands {
-                    link.apply_launcher_commands(commands)?;
-                }
-                link.apply_life_changes(&mut world);
-            }
-        }
+        faults.before_tick(
+            link.tick() + 1,
+            &mut link,
+            &mut world,
+            &mut events,
+            &commands,
+        )?;
         let tick_started = Instant::now();
         let outcome = link.tick_with(|_, frames| world.sense(frames))?;
         for robot in 0..robots {
             match link
                 .command(robot as u32)
-                .filter(|_| faults.as_ref().is_none_or(|driver| driver.is_alive(robot)))
+                .filter(|_| faults.is_alive(robot))
             {
                 Some(command) => {
                     commands[robot] = *command;
@@ -211,9 +197,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         "real_time": pacer.summary(ticks),
     });
     if let Some(object) = extra.as_object_mut() {
-        if let Some(driver) = &faults {
-            object.insert("alive_final".into(), driver.alive_count().into());
-        }
+        object.insert("alive_final".into(), faults.alive_count().into());
         if let Some(hosts) = link.summary() {
             object.insert("hosts".into(), hosts);
         }

@@ -1,23 +1,33 @@
 //! The world's link to its robots: the local lockstep over iceoryx2, or `swarm host` daemons over zenoh when the
 //! run places its robots on hosts (`--hosts` or the experiment's `<hosts>`).
 //!
-//! Both give the main loop the same tick: fill the frames, get each robot's command or none. Deaths reach the
-//! world differently (the launcher's notices for local agents, the hosts' replies and liveliness for remote ones)
-//! and are applied to the world between ticks. A local run never opens a zenoh session.
+//! Both give the main loop the same tick: fill the frames, get each robot's command or none, and give the fault
+//! driver the same handles on agents: stop waiting for one, wait for it again, replace it. Locally the launcher
+//! signals and restarts processes and the link only changes who the ticks wait for; on hosts each of these is a
+//! fault order to the robot's host. Deaths reach the world differently (the launcher's notices for local agents,
+//! the hosts' replies and liveliness for remote ones). A local run never opens a zenoh session.
 
-use std::sync::mpsc::Receiver;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
 use swarm_runtime::launcher::hosts::HostsPlan;
 use swarm_runtime::launcher::process_args::WorldArgs;
-use swarm_runtime::launcher::world_control::WorldCommand;
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame, SupervisorSnapshot};
 use swarm_runtime::remote::codec::DEFAULT_MAX_PAYLOAD;
-use swarm_runtime::remote::world_bridge::{HostEvent, RemoteHosts, RemoteOptions};
-use swarm_runtime::transport::{TickOutcome, WorldLink};
-use swarm_world::World;
-use swarm_world::entities::RobotId;
+use swarm_runtime::remote::orders::OrderAction;
+use swarm_runtime::remote::world_bridge::{HostEvent, RemoteHosts, RemoteOptions, RobotNews};
+use swarm_runtime::transport::{CommandStatus, TickOutcome, WorldLink};
+
+/// Why the ticks stop waiting for a robot's agent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// The schedule kills it (locally the launcher sends the signal).
+    Kill,
+    /// The schedule freezes it (likewise).
+    Freeze,
+    /// It missed a tick's deadline; its agent may still run.
+    Skip,
+}
 
 /// Where the world's robots run.
 // One value per world process, created once: the size difference between the variants costs nothing.
@@ -72,6 +82,11 @@ impl Link {
         }
     }
 
+    /// Robots in the run.
+    pub fn robots(&self) -> usize {
+        self.statuses().len()
+    }
+
     /// The last tick run.
     pub fn tick(&self) -> u64 {
         match self {
@@ -99,35 +114,98 @@ impl Link {
         }
     }
 
-    /// Applies deaths and returns learnt from the hosts since the last call to the world (local deaths go
-    /// through the fault driver).
-    pub fn apply_life_changes(&mut self, world: &mut World) {
+    /// The robots' command statuses of the last tick.
+    pub fn statuses(&self) -> &[CommandStatus] {
         match self {
-            Link::Local(_) => {}
-            Link::Remote(hosts) => {
-                for (robot, alive) in hosts.take_changes() {
-                    world.set_alive(RobotId(robot), alive);
-                }
-            }
+            Link::Local(link) => link.statuses(),
+            Link::Remote(hosts) => hosts.statuses(),
         }
     }
 
-    /// Carries out the launcher's lines that arrived so far in a run on hosts (`kill-host`); local runs take
-    /// theirs through the fault driver.
-    pub fn apply_launcher_commands(
-        &mut self,
-        commands: &Receiver<WorldCommand>,
-    ) -> anyhow::Result<()> {
-        let Link::Remote(hosts) = self else {
-            return Ok(());
-        };
-        while let Ok(command) = commands.try_recv() {
-            match command {
-                WorldCommand::KillHost(index) => hosts.kill_host(index as usize)?,
-                other => {
-                    tracing::warn!(?other, "ignoring a launcher line that does not apply here")
-                }
+    /// Ticks stop waiting for `robot`'s agent (on a host: killed or frozen there as well).
+    pub fn stop(&mut self, robot: u32, why: Stop) -> anyhow::Result<()> {
+        match self {
+            Link::Local(link) => link.mark_dead(robot)?,
+            Link::Remote(hosts) => {
+                let action = match why {
+                    Stop::Kill => OrderAction::Kill,
+                    Stop::Freeze => OrderAction::Freeze,
+                    Stop::Skip => OrderAction::Skip,
+                };
+                // A host that cannot carry it out is lost or its agent is gone: the robot is out either way.
+                hosts.order(robot, action)?;
             }
+        }
+        Ok(())
+    }
+
+    /// Ticks wait for `robot`'s agent again (on a host, `thaw` also continues it there); `false` when its agent
+    /// is gone.
+    pub fn revive(&mut self, robot: u32, thaw: bool) -> anyhow::Result<bool> {
+        Ok(match self {
+            Link::Local(link) => link.revive(robot),
+            Link::Remote(hosts) => {
+                let action = if thaw {
+                    OrderAction::Thaw
+                } else {
+                    OrderAction::Revive
+                };
+                hosts.order(robot, action)?
+            }
+        })
+    }
+
+    /// The launcher replaces `robot`'s agent, resuming from `snapshot` of tick `tick`: locally the launcher
+    /// starts the process; on a host the host does, and this returns once it joined (`false`: it could not).
+    pub fn respawn(
+        &mut self,
+        robot: u32,
+        tick: u64,
+        snapshot: SupervisorSnapshot,
+    ) -> anyhow::Result<bool> {
+        Ok(match self {
+            Link::Local(_) => true,
+            Link::Remote(hosts) => hosts.order(
+                robot,
+                OrderAction::Respawn {
+                    tick,
+                    snapshot: Box::new(snapshot),
+                },
+            )?,
+        })
+    }
+
+    /// Whether `robot` has an agent the ticks can wait for (e.g. a replacement has joined).
+    pub fn agent_present(&self, robot: u32) -> bool {
+        match self {
+            Link::Local(link) => link.agent_present(robot),
+            Link::Remote(hosts) => hosts.agent_present(robot),
+        }
+    }
+
+    /// Waits up to `poll` for local agents to join (serving replacements' requests); `false` for hosts, whose
+    /// replacements have joined when their order was answered, so there is nothing to wait for.
+    pub fn poll_agents(&mut self, poll: Duration) -> bool {
+        match self {
+            Link::Local(link) => {
+                let _ = link.wait_for_agents(poll);
+                true
+            }
+            Link::Remote(_) => false,
+        }
+    }
+
+    /// What the hosts reported since the last call (nothing for a local run, whose deaths come from the launcher).
+    pub fn take_news(&mut self, news: &mut Vec<RobotNews>) {
+        if let Link::Remote(hosts) = self {
+            news.extend(hosts.take_news());
+        }
+    }
+
+    /// `swarm ctl kill-host`: tells host `index` of the placement to die (nothing for a local run).
+    pub fn kill_host(&self, index: usize) -> anyhow::Result<()> {
+        if let Link::Remote(hosts) = self {
+            hosts.kill_host(index)?;
         }
         Ok(())
     }
