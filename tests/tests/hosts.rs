@@ -17,6 +17,8 @@ use swarm_system_tests::{
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
 /// Robots of the fault tests' runs.
 const RUN_ROBOTS: usize = 6;
+/// The restart policy of the host fault tests whose lost robots come back with their host.
+const RESTART_ON_FAILURE: [&str; 2] = ["--fault", "restart policy=on-failure backoff=0"];
 /// Generous bound for events that take milliseconds to seconds (process start-up under a loaded machine).
 const EVENT_TIMEOUT: Duration = Duration::from_secs(120);
 
@@ -411,12 +413,37 @@ fn assert_resumed_after(log: &str, lost: u64) {
     }
 }
 
-/// A run on hosts `names`; host 1 goes with `take_down` (given the hosts and the run directory) once it ticks, is
-/// restarted after the world noticed the loss, and rejoins; the records say so.
-fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Path)) {
+/// Checks the summary recorded one loss and one return of host 1, and that its first robot, whose restart policy
+/// does not restart it, stayed dead from the tick after the loss although its host came back.
+fn assert_lost_for_good(out: &Path) {
+    let summary = summary(out);
+    let host = &summary["hosts"]["hosts"][1];
+    let lost: Vec<u64> = serde_json::from_value(host["lost_at_ticks"].clone()).expect("lost ticks");
+    let back: Vec<u64> =
+        serde_json::from_value(host["rejoined_at_ticks"].clone()).expect("rejoin ticks");
+    assert_eq!((lost.len(), back.len()), (1, 1), "{summary}");
+    let robot = host["robots"][0].as_u64().expect("a robot id") as usize;
+    let timeline = alive_over_time(out, robot, RUN_ROBOTS);
+    assert!(timeline.last().is_some_and(|(tick, _)| *tick > back[0]));
+    for (tick, alive) in timeline {
+        assert_eq!(
+            alive,
+            tick <= lost[0],
+            "robot {robot} alive at tick {tick} (lost {}, host back {})",
+            lost[0],
+            back[0]
+        );
+    }
+}
+
+/// A run on hosts `names` (whose robots the launcher restarts on failure if `restart`); host 1 goes with
+/// `take_down` (given the hosts and the run directory) once it ticks, is restarted after the world noticed the
+/// loss, and rejoins; the records say whether its robots came back.
+fn lose_and_restart_host(names: &[&str], restart: bool, take_down: impl FnOnce(&mut Hosts, &Path)) {
     let mut hosts = Hosts::start(names);
     let out = tempfile::tempdir().expect("a temporary directory");
-    let mut run = BackgroundRun::start(out.path(), &hosts, &[]);
+    let policy: &[&str] = if restart { &RESTART_ON_FAILURE } else { &[] };
+    let mut run = BackgroundRun::start(out.path(), &hosts, policy);
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
         "host {} never ticked:\n{}",
@@ -432,24 +459,36 @@ fn lose_and_restart_host(names: &[&str], take_down: impl FnOnce(&mut Hosts, &Pat
         "the restarted host never ticked:\n{}",
         hosts.daemons[1].log()
     );
+    let (needle, what) = if restart {
+        ("the share's robots take part", "took part again")
+    } else {
+        ("carrying out a fault order", "were killed again")
+    };
     assert!(
-        hosts.daemons[1].wait_for("the share's robots take part", EVENT_TIMEOUT),
-        "the rejoined host's robots never took part again:\n{}",
+        hosts.daemons[1].wait_for(needle, EVENT_TIMEOUT),
+        "the rejoined host's robots never {what}:\n{}",
         hosts.daemons[1].log()
     );
     run.interrupt();
-    assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
+    if restart {
+        assert_lost_and_rejoined(out.path(), &hosts.daemons[1]);
+    } else {
+        assert_lost_for_good(out.path());
+    }
     hosts.stop_and_check_clean();
 }
 
 #[test]
 fn a_killed_host_is_lost_its_robots_die_and_a_restarted_one_rejoins() {
-    lose_and_restart_host(&["gamma", "delta"], |hosts, _| hosts.daemons[1].kill());
+    lose_and_restart_host(&["gamma", "delta"], true, |hosts, _| {
+        hosts.daemons[1].kill()
+    });
 }
 
+/// Without a restart policy the lost robots stay dead, as killed local agents do.
 #[test]
-fn a_host_killed_with_swarm_ctl_dies_is_lost_and_a_restarted_one_rejoins() {
-    lose_and_restart_host(&["eta", "theta"], |hosts, out| {
+fn a_host_killed_with_swarm_ctl_dies_is_lost_and_its_robots_stay_dead_without_a_restart_policy() {
+    lose_and_restart_host(&["eta", "theta"], false, |hosts, out| {
         assert_eq!(
             swarm_ctl(out, &["kill-host", "theta"]),
             "host theta killed\n"
@@ -472,7 +511,7 @@ fn a_partitioned_host_is_lost_after_the_lease_and_rejoins_when_its_link_returns(
         return;
     }
     let out = tempfile::tempdir().expect("a temporary directory");
-    let mut run = BackgroundRun::start(out.path(), &hosts, &[]);
+    let mut run = BackgroundRun::start(out.path(), &hosts, &RESTART_ON_FAILURE);
     assert!(
         hosts.daemons[1].wait_for("first tick of the share", EVENT_TIMEOUT),
         "host zeta never ticked:\n{}",

@@ -123,16 +123,9 @@ impl Supervision {
         };
         self.faults[index].detection_tick = Some(tick);
         self.faults[index].detection_ms = gone_at.map(millis_since);
-        match cause {
+        if cause == DownCause::Deadline {
             // Its agent still runs (frozen or late); the world takes it back when it answers again.
-            DownCause::Deadline => return,
-            // The host's return restarts it, whatever its policy.
-            DownCause::HostLost => {
-                self.robots[robot as usize].state = AgentState::Restarting;
-                self.robots[robot as usize].open_fault = Some(index);
-                return;
-            }
-            DownCause::Notice => {}
+            return;
         }
         let entry = &mut self.robots[robot as usize];
         // A death the launcher did not see (a notice from elsewhere) counts as a failure.
@@ -345,12 +338,13 @@ impl Supervision {
         Ok(())
     }
 
-    /// Starts a replacement agent for `robot` (from its resume point when `resume`); returns its pid (0 on
-    /// hosts: the world has the robot's host start it, always from the world's record).
+    /// Starts a replacement agent for `robot` (from its resume point when `resume`) and tells the world, which
+    /// takes a restarted robot back once its agent is there; returns its pid (0 on hosts: the world has the
+    /// robot's host start it, always from the world's record).
     fn spawn_replacement(&mut self, robot: u32, resume: bool) -> Result<u32, LaunchError> {
+        self.send_world(WorldCommand::Respawn(robot));
         if self.on_hosts() {
             tracing::info!(robot, "restarting the robot's agent on its host");
-            self.send_world(WorldCommand::Respawn(robot));
             return Ok(0);
         }
         let point = resume.then(|| ResumePoint::path(&self.out_dir, robot));

@@ -3,8 +3,9 @@
 //! `dead 3` (the OS reported robot 3's agent gone), `rejoin 3 58` (robot 3's replacement takes part from tick
 //! 58: the world holds that tick until it has joined) and `applied 50` (every fault due at tick 50 is done: the
 //! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`) and
-//! `respawn 3` (robot 3 runs on a host and its restart policy replaces its agent: the world has the host start one
-//! that resumes from the world's record). Plain text, so a person can drive a world by hand.
+//! `respawn 3` (robot 3's restart policy replaces its agent: the world takes it back once the replacement is
+//! there; for a robot on a host the world has the host start it, resuming from the world's record). Plain text,
+//! so a person can drive a world by hand.
 
 use std::fmt;
 
@@ -24,7 +25,7 @@ pub enum WorldCommand {
     Applied(u64),
     /// Host with this index in the placement is to die.
     KillHost(u32),
-    /// Robot (on a host) gets a replacement agent.
+    /// Robot gets a replacement agent.
     Respawn(u32),
 }
 

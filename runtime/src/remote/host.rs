@@ -520,6 +520,7 @@ impl Share {
             .iter()
             .position(|&r| r == robot)
             .ok_or_else(|| format!("robot {robot} is not in this host's share"))?;
+        tracing::info!(robot, order = action.name(), "carrying out a fault order");
         let slot_id = slot as u32;
         let link = self.link.as_ref().ok_or("the share is ending")?;
         let agent = self.children.agents.get(slot).and_then(Option::as_ref);

@@ -752,10 +752,13 @@ impl RemoteHosts {
         self.news.drain(..)
     }
 
-    /// Whether `robot`'s host runs an agent for it, as far as the world knows.
+    /// Whether `robot`'s host runs an agent for it, as far as the world knows, and has run a tick with it (a
+    /// rejoined host's robots are present from the end of its first tick back).
     pub fn agent_present(&self, robot: u32) -> bool {
+        let host = &self.hosts[self.owner[robot as usize]];
         self.present.get(robot as usize) == Some(&true)
-            && self.hosts[self.owner[robot as usize]].state == State::Live
+            && host.state == State::Live
+            && host.live_from <= self.tick
     }
 
     /// Sends `robot`'s host a fault order and waits for the answer (a replacement agent's join included), while

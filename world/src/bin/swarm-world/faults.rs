@@ -18,9 +18,9 @@
 //! This module never signals a process: the launcher does that for local agents, and for robots on hosts the
 //! [`Link`] turns each step into a fault order to the robot's host. There the deaths come from the hosts (an
 //! agent that ended, a host lost) instead of the launcher's notices, and the launcher's `respawn r` lines
-//! become replacement agents on the robot's host. A robot whose host is lost is down until the host is back
-//! (whatever its restart policy: the host's return restarts its whole share); a robot that was already dead for
-//! good stays dead, its fresh agent on the returning host killed again.
+//! become replacement agents on the robot's host. A robot whose host is lost is down like a dead one: if its
+//! restart policy restarts it, the host's fresh agent (or one the host starts, if it is already back) is its
+//! replacement; otherwise the returning host's agent for it is killed again.
 
 use std::io::BufRead;
 use std::path::PathBuf;
@@ -81,10 +81,11 @@ pub struct FaultDriver {
     commands: Receiver<WorldCommand>,
     notices: Vec<u32>,
     applied: Vec<u64>,
-    /// Robots the launcher replaces (`respawn r`: robots on hosts), in order.
+    /// Robots the launcher replaces (`respawn r`), in order.
     respawns: Vec<u32>,
-    /// Robots whose replacement could not start because their host was away: its return brings one.
-    respawn_pending: Vec<bool>,
+    /// Per robot: the launcher restarted it and it has not taken part since; only such a robot comes back
+    /// when an agent of it is present (a robot on a host whose host was away gets its agent with the host).
+    restart_due: Vec<bool>,
     /// Each robot's snapshot (and its tick) from when it was last marked dead, for its replacement.
     resume: Vec<(u64, SupervisorSnapshot)>,
     news: Vec<RobotNews>,
@@ -160,7 +161,7 @@ impl FaultDriver {
             notices: Vec::new(),
             applied: Vec::new(),
             respawns: Vec::new(),
-            respawn_pending: vec![false; robots],
+            restart_due: vec![false; robots],
             resume: vec![(0, SupervisorSnapshot::default()); robots],
             news: Vec::new(),
             host_kills: Vec::new(),
@@ -297,7 +298,10 @@ impl FaultDriver {
         }
         for robot in 0..self.robots.len() as u32 {
             let r = robot as usize;
-            if !matches!(self.robots[r], Robot::Down(Down::Notice | Down::Killed)) {
+            if !matches!(
+                self.robots[r],
+                Robot::Down(Down::Notice | Down::Killed | Down::HostLost)
+            ) {
                 continue;
             }
             match self.rejoin_at[r] {
@@ -309,7 +313,7 @@ impl FaultDriver {
                     }
                 }
                 _ => {
-                    if link.agent_present(robot) {
+                    if self.restart_due[r] && link.agent_present(robot) {
                         self.rejoin_at[r] = None;
                         self.mark_up(robot, tick, world, events)?;
                     }
@@ -319,19 +323,22 @@ impl FaultDriver {
         self.scheduled(tick, link, world, events, commands)
     }
 
-    /// Starts the replacements the launcher asked for (robots on hosts; a local launcher starts its own).
+    /// Takes in the launcher's restarts; on hosts, has each robot's host start the replacement (a local
+    /// launcher starts its own). A host that is away starts one when it is back.
     fn respawn_requested(&mut self, link: &mut Link) -> anyhow::Result<()> {
         for robot in std::mem::take(&mut self.respawns) {
             let (tick, snapshot) = self.resume[robot as usize];
-            let started = link.respawn(robot, tick, snapshot)?;
-            self.respawn_pending[robot as usize] = !started;
+            self.restart_due[robot as usize] = true;
+            if !link.respawn(robot, tick, snapshot)? {
+                tracing::info!(robot, "the robot's replacement waits for its host");
+            }
         }
         Ok(())
     }
 
     /// Takes in what the hosts reported: an agent that ended is a death notice; a lost host's robots are down
-    /// until it is back; a returning host's fresh agents take part if their robot was lost with the host or is
-    /// to be restarted, and are killed again if their robot is dead for good.
+    /// like dead ones (their restart policy decides whether they come back with the host); a returning host's
+    /// fresh agents are the replacements of robots the launcher restarted, and are killed again for the others.
     fn hosts_news(
         &mut self,
         tick: u64,
@@ -359,15 +366,9 @@ impl FaultDriver {
                 }
                 RobotNews::HostBack(robot) => {
                     let r = robot as usize;
-                    match self.robots[r] {
-                        Robot::Down(Down::HostLost) => self.mark_up(robot, tick, world, events)?,
-                        Robot::Down(Down::Notice | Down::Killed)
-                            if self.respawn_pending[r] || self.rejoin_at[r].is_some() =>
-                        {
-                            // The fresh agent is the replacement; the restarts below take it in.
-                            self.respawn_pending[r] = false;
-                        }
-                        _ => link.stop(robot, Stop::Kill)?,
+                    // A restarted robot's fresh agent is its replacement: the restarts take it in.
+                    if !self.restart_due[r] && self.rejoin_at[r].is_none() {
+                        link.stop(robot, Stop::Kill)?;
                     }
                 }
             }
@@ -504,6 +505,7 @@ impl FaultDriver {
         events: &mut EventsWriter,
     ) -> anyhow::Result<()> {
         self.robots[robot as usize] = Robot::Alive;
+        self.restart_due[robot as usize] = false;
         world.set_alive(RobotId(robot), true);
         events.record_fault(tick, robot as usize, "fault:up")?;
         report(WorldReport::Up { tick, robot });
