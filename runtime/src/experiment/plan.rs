@@ -321,6 +321,16 @@ mod tests {
                 480,
                 vec![10, 20, 40, 70, 100],
             ),
+            (
+                "foraging/grid_thesis_5min_plotted.toml",
+                40,
+                vec![10, 20, 40, 70, 100],
+            ),
+            (
+                "foraging/grid_thesis_full_sample.toml",
+                16,
+                vec![20, 40, 70, 100],
+            ),
         ] {
             let grid = Grid::load(&configs.join(file)).unwrap_or_else(|e| panic!("{e}"));
             let configurations = configurations(&grid).unwrap_or_else(|e| panic!("{e}"));

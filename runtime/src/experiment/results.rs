@@ -107,15 +107,16 @@ pub struct ConfigResult {
     pub configuration: usize,
     /// Indices (into the run results) of its finished runs.
     pub runs: Vec<usize>,
-    /// The run whose main metric is the median over the runs (the lower median for an even count); `None` when
-    /// no run reports the metric.
+    /// The run whose main metric is the median over the runs (the lower median for an even count); a run that
+    /// does not report the metric ranks after every run that does (a time not reached before the run ended, such
+    /// as the last delivery of a run cut at its tick limit). `None` when the configuration has no finished run.
     pub median_run: Option<usize>,
     /// Statistics of every metric over the runs.
     pub stats: BTreeMap<String, Stats>,
 }
 
-/// Groups runs by configuration and selects each configuration's median run by `metric`; ties go to the
-/// smaller seed.
+/// Groups runs by configuration and selects each configuration's median run by `metric` (runs without it rank
+/// last); ties go to the smaller seed.
 pub fn select_medians(
     configurations: usize,
     runs: &[RunResult],
@@ -128,7 +129,10 @@ pub fn select_medians(
                 .collect();
             let mut ranked: Vec<(f64, u64, usize)> = mine
                 .iter()
-                .filter_map(|&i| runs[i].metrics.get(metric).map(|&v| (v, runs[i].seed, i)))
+                .map(|&i| {
+                    let value = runs[i].metrics.get(metric).copied();
+                    (value.unwrap_or(f64::INFINITY), runs[i].seed, i)
+                })
                 .collect();
             ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             let median_run = (!ranked.is_empty()).then(|| ranked[(ranked.len() - 1) / 2].2);
@@ -328,7 +332,25 @@ mod tests {
     }
 
     #[test]
-    fn configuration_without_the_metric_has_no_median_run() {
+    fn a_run_without_the_metric_ranks_after_every_run_with_it() {
+        let mut censored = run(0, 2, 0.0);
+        censored.metrics.remove("TO");
+        let runs = vec![run(0, 1, 10.0), censored.clone(), run(0, 3, 20.0)];
+        let results = select_medians(1, &runs, "TO");
+        assert_eq!(results[0].median_run.map(|i| runs[i].seed), Some(3));
+        let mut twice = censored;
+        twice.seed = 4;
+        let runs = vec![run(0, 1, 10.0), runs[1].clone(), twice];
+        let results = select_medians(1, &runs, "TO");
+        assert_eq!(
+            results[0].median_run.map(|i| runs[i].seed),
+            Some(2),
+            "two of three runs never reached it: the median did not either"
+        );
+    }
+
+    #[test]
+    fn configuration_without_runs_has_no_median_run() {
         let runs = vec![run(1, 1, 5.0)];
         let results = select_medians(2, &runs, "TO");
         assert_eq!(results[0].median_run, None);

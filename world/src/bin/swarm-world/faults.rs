@@ -129,7 +129,7 @@ impl FaultDriver {
     /// can join: every robot starts without an agent in the transport (a death notice each), so a robot counts
     /// as present only once its agent has connected, not merely claimed its slot.
     pub fn new(
-        link: &mut Link,
+        link: &Link,
         schedule: &FaultSchedule,
         ticks_per_second: u32,
         seed: u64,

@@ -115,7 +115,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         }
     };
     let mut faults = FaultDriver::new(
-        &mut link,
+        &link,
         &schedule,
         experiment.framework.ticks_per_second,
         args.seed,
