@@ -331,6 +331,12 @@ mod tests {
                 16,
                 vec![20, 40, 70, 100],
             ),
+            (
+                "pheromone_foraging/grid_pheromones.toml",
+                6,
+                vec![20, 40, 70],
+            ),
+            ("pheromone_foraging/grid_solitary.toml", 6, vec![20, 40, 70]),
         ] {
             let grid = Grid::load(&configs.join(file)).unwrap_or_else(|e| panic!("{e}"));
             let configurations = configurations(&grid).unwrap_or_else(|e| panic!("{e}"));

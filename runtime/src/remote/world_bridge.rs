@@ -1063,6 +1063,30 @@ mod tests {
     }
 
     #[test]
+    fn an_order_nobody_carries_out_is_reported_and_changes_nothing() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("quiet", &[0, 1])]);
+        // The fake host answers frames but has no orders queryable.
+        let _quiet = FakeHost::start(&endpoint, "quiet", Behaviour::Honest);
+        world
+            .wait_for_hosts(Duration::from_secs(30))
+            .expect("the host joins");
+        world.tick_with(|_, _| {}).expect("a tick");
+        assert_eq!(world.order(1, OrderAction::Kill).ok(), Some(false));
+        assert!(
+            world.agent_present(1),
+            "a kill not carried out keeps the agent"
+        );
+        assert_eq!(
+            world.order(7, OrderAction::Kill).ok(),
+            Some(false),
+            "a robot of no host"
+        );
+        let outcome = world.tick_with(|_, _| {}).expect("the next tick");
+        assert_eq!(outcome.answered, 2, "ticks go on as before");
+    }
+
+    #[test]
     fn a_malformed_batch_is_dropped_and_counted_and_the_tick_goes_on() {
         let endpoint = endpoint();
         let mut world = world(&endpoint, &[("garbled", &[0])]);
