@@ -35,7 +35,7 @@ use super::{RemoteError, keys};
 use crate::launcher::binaries::Binaries;
 use crate::launcher::children::{self, Children};
 use crate::launcher::process_args::{AgentArgs, RunArgs};
-use crate::launcher::resume::ResumePoint;
+use crate::launcher::resume::{ResumeError, ResumePoint};
 use crate::launcher::run_dir;
 use crate::messages::{SensorFrame, SupervisorSnapshot};
 use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink};
@@ -354,9 +354,9 @@ struct Share {
     robots: Vec<u32>,
     spec: RunSpec,
     link: Option<WorldLink>,
+    /// Agent processes by slot; `None` once one ended (killed, exited, or a replacement that never joined): the
+    /// robot is reported `Dead` then.
     children: Children,
-    /// Per slot: its agent process ended (killed or exited) and no replacement has joined since.
-    exited: Vec<bool>,
     /// The robot-agent program and the folder of the agents' logs, for replacements.
     agent: PathBuf,
     logs: PathBuf,
@@ -445,7 +445,6 @@ impl Share {
             spec,
             link: Some(link),
             children: Children::default(),
-            exited: vec![false; count as usize],
             agent: binaries.agent.clone(),
             logs: options.logs.clone(),
             publisher,
@@ -527,7 +526,6 @@ impl Share {
         match action {
             OrderAction::Kill => {
                 self.children.kill_agent(slot_id);
-                self.exited[slot] = true;
                 link.mark_dead(slot_id).map_err(|e| e.to_string())
             }
             OrderAction::Freeze => {
@@ -555,16 +553,11 @@ impl Share {
     ) -> Result<(), String> {
         let robot = self.robots[slot];
         self.children.kill_agent(slot as u32);
-        self.exited[slot] = true;
         let link = self.link.as_ref().ok_or("the share is ending")?;
         link.mark_dead(slot as u32).map_err(|e| e.to_string())?;
-        let point = ResumePoint {
-            robot,
-            tick,
-            snapshot,
-        }
-        .write(&self.logs)
-        .map_err(|e| e.to_string())?;
+        let point = self
+            .write_resume_point(robot, tick, snapshot)
+            .map_err(|e| e.to_string())?;
         let child = self
             .spawn_agent(slot, Some(point))
             .map_err(|e| e.to_string())?;
@@ -578,13 +571,14 @@ impl Share {
             // Serves the replacement's request for a fresh command board while waiting.
             let _ = link.wait_for_agents(REPLACEMENT_POLL);
             if link.agent_present(slot as u32) {
-                self.exited[slot] = false;
                 return Ok(());
             }
             if let Some(failure) = self.failed_start(|s| s == slot) {
                 return Err(failure);
             }
             if Instant::now() >= deadline {
+                // A replacement that never joined is no agent of the slot: the robot stays `Dead`.
+                self.children.kill_agent(slot as u32);
                 return Err(format!(
                     "robot {robot}'s replacement agent did not join within {} ms",
                     self.assignment.join_timeout_ms
@@ -616,21 +610,28 @@ impl Share {
         live.peek().is_some() && live.all(|(_, reply)| matches!(reply, Reply::Answered(_)))
     }
 
-    /// Writes a rejoining share's resume points (`<logs>/resume/robot-<id>.json`, as in a run directory) and
-    /// returns them in slot order; none on a first assignment.
+    /// Writes a rejoining share's resume points and returns them in slot order; none on a first assignment.
     fn write_resume_points(&self) -> Result<Vec<PathBuf>, RemoteError> {
         let robots = self.assignment.robots.iter().map(|(id, _)| *id);
         robots
             .zip(&self.assignment.resume)
-            .map(|(robot, &(tick, snapshot))| {
-                let point = ResumePoint {
-                    robot,
-                    tick,
-                    snapshot,
-                };
-                Ok(point.write(&self.logs)?)
-            })
+            .map(|(robot, &(tick, snapshot))| Ok(self.write_resume_point(robot, tick, snapshot)?))
             .collect()
+    }
+
+    /// Writes robot `robot`'s resume point (`<logs>/resume/robot-<id>.json`, as in a run directory).
+    fn write_resume_point(
+        &self,
+        robot: u32,
+        tick: u64,
+        snapshot: SupervisorSnapshot,
+    ) -> Result<PathBuf, ResumeError> {
+        ResumePoint {
+            robot,
+            tick,
+            snapshot,
+        }
+        .write(&self.logs)
     }
 
     /// Waits for every agent to join; an agent that exits first fails the share with the end of its log.
@@ -660,7 +661,6 @@ impl Share {
         for &(slot, status) in &exits {
             let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
             tracing::warn!(robot, %status, "robot agent died");
-            self.exited[slot as usize] = true;
             if let Some(link) = &self.link
                 && let Err(e) = link.mark_dead(slot)
             {
@@ -695,7 +695,7 @@ impl Share {
             return Ok(());
         }
         self.reap();
-        let exited = &self.exited;
+        let agents = &self.children.agents;
         let Some(link) = self.link.as_mut() else {
             return Ok(());
         };
@@ -711,7 +711,7 @@ impl Share {
                     command.tick = header.tick;
                     Reply::Answered(command)
                 }
-                _ if exited[slot] => Reply::Dead,
+                _ if agents[slot].is_none() => Reply::Dead,
                 _ => Reply::Missing,
             };
         }
