@@ -117,30 +117,17 @@ enum Incoming {
     OrderEnded(u64),
 }
 
-/// Says when an order query is finished.
-struct OrderGuard {
+/// Says when a query is finished (after its answer, if any): zenoh drops the reply callback, and this with it.
+struct QueryEnded {
     sender: Sender<Incoming>,
-    order: u64,
+    ended: Option<Incoming>,
 }
 
-impl Drop for OrderGuard {
+impl Drop for QueryEnded {
     fn drop(&mut self) {
-        let _ = self.sender.send(Incoming::OrderEnded(self.order));
-    }
-}
-
-/// Says when an assignment query is finished: zenoh drops the reply callback, and this with it.
-struct AssignmentGuard {
-    sender: Sender<Incoming>,
-    host: usize,
-    epoch: u32,
-}
-
-impl Drop for AssignmentGuard {
-    fn drop(&mut self) {
-        let _ = self
-            .sender
-            .send(Incoming::AssignEnded(self.host, self.epoch));
+        if let Some(ended) = self.ended.take() {
+            let _ = self.sender.send(ended);
+        }
     }
 }
 
@@ -580,32 +567,52 @@ impl RemoteHosts {
             },
         };
         let payload = codec::encode_message(&assignment)?;
-        let sender = self.sender.clone();
-        let ended = AssignmentGuard {
-            sender: self.sender.clone(),
-            host: index,
-            epoch: host.epoch,
-        };
         tracing::info!(
             host = host.share.name,
             epoch = host.epoch,
             robots = host.share.robots.len(),
             "assigning"
         );
+        let key = keys::assign(&host.share.name);
+        let ended = Incoming::AssignEnded(index, host.epoch);
+        self.query(
+            key,
+            payload,
+            self.options.join_timeout + Duration::from_secs(5),
+            move |answer| Incoming::Assigned(index, answer),
+            ended,
+        )
+        .map_err(zenoh_error("sending a host its share"))
+    }
+
+    /// Sends a query whose answer arrives as the event `answered` makes of it, followed by `ended` when the
+    /// query is finished (answered or not).
+    fn query(
+        &self,
+        key: String,
+        payload: Vec<u8>,
+        timeout: Duration,
+        answered: impl Fn(Result<Vec<u8>, String>) -> Incoming + Send + Sync + 'static,
+        ended: Incoming,
+    ) -> Result<(), zenoh::Error> {
+        let sender = self.sender.clone();
+        let ended = QueryEnded {
+            sender: self.sender.clone(),
+            ended: Some(ended),
+        };
         self.session
-            .get(keys::assign(&host.share.name))
+            .get(key)
             .payload(payload)
-            .timeout(self.options.join_timeout + Duration::from_secs(5))
+            .timeout(timeout)
             .callback(move |reply| {
                 let _ = &ended;
                 let answer = match reply.result() {
                     Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
                     Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
                 };
-                let _ = sender.send(Incoming::Assigned(index, answer));
+                let _ = sender.send(answered(answer));
             })
             .wait()
-            .map_err(zenoh_error("sending a host its share"))
     }
 
     fn assigned(
@@ -755,10 +762,11 @@ impl RemoteHosts {
     /// Whether `robot`'s host runs an agent for it, as far as the world knows, and has run a tick with it (a
     /// rejoined host's robots are present from the end of its first tick back).
     pub fn agent_present(&self, robot: u32) -> bool {
-        let host = &self.hosts[self.owner[robot as usize]];
-        self.present.get(robot as usize) == Some(&true)
-            && host.state == State::Live
-            && host.live_from <= self.tick
+        let r = robot as usize;
+        self.owner.get(r).is_some_and(|&index| {
+            let host = &self.hosts[index];
+            self.present[r] && host.state == State::Live && host.live_from <= self.tick
+        })
     }
 
     /// Sends `robot`'s host a fault order and waits for the answer (a replacement agent's join included), while
@@ -787,25 +795,14 @@ impl RemoteHosts {
         self.orders_sent += 1;
         self.answer = None;
         let number = self.orders_sent;
-        let sender = self.sender.clone();
-        let ended = OrderGuard {
-            sender: self.sender.clone(),
-            order: number,
-        };
-        self.session
-            .get(keys::orders(&name))
-            .payload(payload)
-            .timeout(timeout)
-            .callback(move |reply| {
-                let _ = &ended;
-                let answer = match reply.result() {
-                    Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
-                    Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
-                };
-                let _ = sender.send(Incoming::Ordered(number, answer));
-            })
-            .wait()
-            .map_err(zenoh_error("sending a host a fault order"))?;
+        self.query(
+            keys::orders(&name),
+            payload,
+            timeout,
+            move |answer| Incoming::Ordered(number, answer),
+            Incoming::OrderEnded(number),
+        )
+        .map_err(zenoh_error("sending a host a fault order"))?;
         let deadline = Instant::now() + timeout;
         while self.answer.is_none() {
             let now = Instant::now();
