@@ -33,7 +33,7 @@ use swarm_runtime::launcher::faults::{FaultAction, FaultPlan};
 use swarm_runtime::launcher::resume::ResumePoint;
 use swarm_runtime::launcher::world_control::WorldCommand;
 use swarm_runtime::launcher::world_report::{DownCause, WorldReport};
-use swarm_runtime::messages::{ActuatorCommand, SupervisorSnapshot};
+use swarm_runtime::messages::ActuatorCommand;
 use swarm_runtime::remote::world_bridge::RobotNews;
 use swarm_runtime::transport::{CommandStatus, DeathNotices};
 use swarm_world::World;
@@ -86,8 +86,6 @@ pub struct FaultDriver {
     /// Per robot: the launcher restarted it and it has not taken part since; only such a robot comes back
     /// when an agent of it is present (a robot on a host whose host was away gets its agent with the host).
     restart_due: Vec<bool>,
-    /// Each robot's snapshot (and its tick) from when it was last marked dead, for its replacement.
-    resume: Vec<(u64, SupervisorSnapshot)>,
     news: Vec<RobotNews>,
     /// `swarm ctl kill-host` requests (host indices).
     host_kills: Vec<u32>,
@@ -162,7 +160,6 @@ impl FaultDriver {
             applied: Vec::new(),
             respawns: Vec::new(),
             restart_due: vec![false; robots],
-            resume: vec![(0, SupervisorSnapshot::default()); robots],
             news: Vec::new(),
             host_kills: Vec::new(),
             due,
@@ -209,7 +206,7 @@ impl FaultDriver {
                 events.flush()?;
                 report(WorldReport::Await { tick: 0 });
                 self.wait_applied(0)?;
-                self.respawn_requested(link)?;
+                self.respawn_requested(link, commands)?;
             }
             return Ok(());
         }
@@ -256,7 +253,7 @@ impl FaultDriver {
         for host in std::mem::take(&mut self.host_kills) {
             link.kill_host(host as usize)?;
         }
-        self.respawn_requested(link)?;
+        self.respawn_requested(link, commands)?;
         self.hosts_news(tick, link, world, events, commands)?;
         for robot in std::mem::take(&mut self.notices) {
             match self.robots[robot as usize] {
@@ -323,13 +320,18 @@ impl FaultDriver {
         self.scheduled(tick, link, world, events, commands)
     }
 
-    /// Takes in the launcher's restarts; on hosts, has each robot's host start the replacement (a local
-    /// launcher starts its own). A host that is away starts one when it is back.
-    fn respawn_requested(&mut self, link: &mut Link) -> anyhow::Result<()> {
+    /// Takes in the launcher's restarts; on hosts, has each robot's host start the replacement from the robot's
+    /// last recorded command, the one its resume point was written from (a dead robot's command is not updated;
+    /// a local launcher starts its own replacement). A host that is away starts one when it is back.
+    fn respawn_requested(
+        &mut self,
+        link: &mut Link,
+        commands: &[ActuatorCommand],
+    ) -> anyhow::Result<()> {
         for robot in std::mem::take(&mut self.respawns) {
-            let (tick, snapshot) = self.resume[robot as usize];
+            let last = last_command(commands, robot);
             self.restart_due[robot as usize] = true;
-            if !link.respawn(robot, tick, snapshot)? {
+            if !link.respawn(robot, last.tick, last.supervisors)? {
                 tracing::info!(robot, "the robot's replacement waits for its host");
             }
         }
@@ -449,7 +451,7 @@ impl FaultDriver {
         events.flush()?;
         report(WorldReport::Await { tick });
         self.wait_applied(tick)?;
-        self.respawn_requested(link)?;
+        self.respawn_requested(link, commands)?;
         for robot in thawed {
             if link.revive(robot, true)? {
                 events.record_fault(tick, robot as usize, "fault:thaw")?;
@@ -474,11 +476,7 @@ impl FaultDriver {
     ) -> anyhow::Result<()> {
         self.robots[robot as usize] = Robot::Down(cause);
         world.set_alive(RobotId(robot), false);
-        let last = commands
-            .get(robot as usize)
-            .copied()
-            .unwrap_or_else(|| ActuatorCommand::idle(robot, 0));
-        self.resume[robot as usize] = (last.tick, last.supervisors);
+        let last = last_command(commands, robot);
         ResumePoint {
             robot,
             tick: last.tick,
@@ -582,4 +580,12 @@ impl FaultDriver {
             }
         }
     }
+}
+
+/// The last command recorded for `robot` (idle at tick 0 if it never answered).
+fn last_command(commands: &[ActuatorCommand], robot: u32) -> ActuatorCommand {
+    commands
+        .get(robot as usize)
+        .copied()
+        .unwrap_or_else(|| ActuatorCommand::idle(robot, 0))
 }
