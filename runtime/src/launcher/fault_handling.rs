@@ -81,13 +81,6 @@ impl Supervision {
                 });
                 self.restart_scheduled(robot, tick, index, true)?;
             }
-            // On hosts the world has the robot's host send the signal.
-            FaultKind::Freeze if self.on_hosts() => {
-                self.robots[robot as usize].state = AgentState::Frozen
-            }
-            FaultKind::Thaw if self.on_hosts() => {
-                self.robots[robot as usize].state = AgentState::Running
-            }
             FaultKind::Freeze => self.signal_agent(robot, Signal::SIGSTOP, AgentState::Frozen),
             FaultKind::Thaw => self.signal_agent(robot, Signal::SIGCONT, AgentState::Running),
             FaultKind::KillWorld => {}
@@ -389,9 +382,12 @@ impl Supervision {
         self.robots[robot as usize].state = AgentState::Dead;
     }
 
-    /// Sends `signal` to `robot`'s agent and records its new state.
+    /// Sends `signal` to `robot`'s agent and records its new state (on hosts only the state: the world has the
+    /// robot's host send the signal).
     fn signal_agent(&mut self, robot: u32, signal: Signal, state: AgentState) {
-        if let Some(Some(child)) = self.children.agents.get(robot as usize) {
+        if self.on_hosts() {
+            self.robots[robot as usize].state = state;
+        } else if let Some(Some(child)) = self.children.agents.get(robot as usize) {
             children::signal(child, signal);
             self.robots[robot as usize].state = state;
         }
