@@ -174,6 +174,38 @@ fn frozen_agent_misses_the_deadline_while_the_others_keep_ticking() {
 }
 
 #[test]
+fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after_it() {
+    let mut run = Run::new();
+    // Two chains of four: 0-1-2-3 and 4-5-6-7. Robot 1 stops answering, so no relay reaches 2 and 3; the
+    // world's rescue must wake them long before the deadline.
+    let mut link_config = config(8, 5_000);
+    link_config.relays = 2;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..8 {
+        let extra: &[&str] = if robot == 1 {
+            &["--freeze-at", "2"]
+        } else {
+            &[]
+        };
+        run.spawn(robot, extra);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    for tick in 2..=4 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!((outcome.answered, outcome.missing), (7, 1), "tick {tick}");
+        assert_eq!(world.statuses()[1], CommandStatus::Missing);
+        for robot in [0, 2, 3, 4, 5, 6, 7] {
+            expect_echo(&world, robot, tick);
+        }
+    }
+    // Once the robot is reported dead, relays step over it.
+    world.mark_dead(1).expect("death notice");
+    let outcome = world.tick_with(sense).expect("tick 5");
+    assert_eq!((outcome.answered, outcome.dead), (7, 1));
+}
+
+#[test]
 fn robot_beyond_the_run_cannot_join_and_the_error_names_the_limit() {
     let run = Run::new();
     let _world = WorldLink::create(&run.spec, config(4, 100)).expect("create world");

@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
+use swarm_runtime::transport::RUN_ROOTS_DIR;
 
 /// The folder holding `swarm`, `swarm-world` and `robot-agent`, brought up to date once per test binary with the
 /// cargo that runs the tests. It asks for exactly the build of the README's test command (`cargo test --workspace`,
@@ -154,9 +155,9 @@ pub fn assert_clean(outcome: &SwarmOutcome) {
     assert_prefix_clean(&outcome.run_prefix());
 }
 
-/// iceoryx2 root directories (`$TMPDIR/iceoryx2-<run>`) left by runs whose name starts with `run_prefix`.
+/// iceoryx2 root directories (`/dev/shm/iceoryx2-<run>`) left by runs whose name starts with `run_prefix`.
 pub fn iceoryx_root_leftovers(run_prefix: &str) -> Vec<PathBuf> {
-    entries_starting_with(&std::env::temp_dir(), &format!("iceoryx2-{run_prefix}"))
+    entries_starting_with(Path::new(RUN_ROOTS_DIR), &format!("iceoryx2-{run_prefix}"))
 }
 
 /// Asserts that the runs of the launcher with process id `pid` left no process, no shared-memory file and no
@@ -221,7 +222,7 @@ pub fn remove_run_leftovers(run_prefix: &str) {
         let _ = std::fs::remove_file(path);
     }
     let root_prefix = format!("iceoryx2-{run_prefix}");
-    if let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) {
+    if let Ok(entries) = std::fs::read_dir(RUN_ROOTS_DIR) {
         for entry in entries.flatten() {
             if entry
                 .file_name()
@@ -502,7 +503,7 @@ pub fn wipe_runs(run_prefix: &str) {
             );
         }
     }
-    let roots = std::fs::read_dir(std::env::temp_dir())
+    let roots = std::fs::read_dir(RUN_ROOTS_DIR)
         .map(|entries| entries.flatten().map(|e| e.path()).collect::<Vec<_>>())
         .unwrap_or_default();
     for root in roots {

@@ -6,7 +6,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::bench::stats::{median, quantile};
-use crate::transport::{LinkConfig, RunSpec, TransportError, WorldLink};
+use crate::transport::{LinkConfig, RunSpec, TransportError, WorldLink, tune_agent_command};
 
 /// Ticks run before measuring, so that every agent is paged in and warm.
 const WARMUP_TICKS: usize = 100;
@@ -105,7 +105,7 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
     let start = Instant::now();
     for robot in 0..robots {
         let mut command = Command::new(agent);
-        command
+        tune_agent_command(&mut command)
             .arg("--run")
             .arg(run.name())
             .arg("--root")

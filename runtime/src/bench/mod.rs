@@ -4,9 +4,11 @@
 //! N/10 cylinders) with one agent process per robot, through the same launcher as `swarm run`, repeated; per N the
 //! medians of robot-steps per second, p50/p99 tick time (the world's own figures from summary.json), time to the
 //! first tick, and each agent's peak RSS. Bare: the lockstep round trip with no world work and no player
-//! ([`bare`]). Real time: one paced run (e.g. 2,000 agents at 10 ticks/s) and whether every tick kept its slot.
+//! ([`bare`]), next to the same-hour floor of a minimal futex-broadcast lockstep ([`floor`]). Real time: one
+//! paced run (e.g. 2,000 agents at 10 ticks/s) and whether every tick kept its slot.
 
 pub mod bare;
+pub mod floor;
 pub mod rss;
 pub mod stats;
 
@@ -83,6 +85,8 @@ pub struct BareFigures {
     pub tick_p99_us: f64,
     /// Seconds from spawning the agents to the end of the first tick.
     pub first_tick_seconds: f64,
+    /// Robot-steps per second of the minimal futex-broadcast lockstep, measured right after ([`floor`]).
+    pub floor_robot_steps_per_second: f64,
 }
 
 /// The real-time check.
@@ -113,7 +117,7 @@ pub struct BenchReport {
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
     /// A run failed.
-    #[error("benchmark run of {config}: {source}")]
+    #[error("benchmark run of {config}")]
     Run {
         /// The configuration.
         config: PathBuf,
@@ -122,13 +126,22 @@ pub enum BenchError {
         source: Box<LaunchError>,
     },
     /// The bare lockstep failed.
-    #[error("bare lockstep with {robots} agents: {source}")]
+    #[error("bare lockstep with {robots} agents")]
     Bare {
         /// Agents.
         robots: u32,
         /// Why.
         #[source]
         source: BareError,
+    },
+    /// The floor could not be measured.
+    #[error("lockstep floor with {robots} processes")]
+    Floor {
+        /// Processes.
+        robots: u32,
+        /// Why.
+        #[source]
+        source: floor::FloorError,
     },
     /// A program is missing.
     #[error(transparent)]
@@ -142,7 +155,7 @@ pub enum BenchError {
         what: String,
     },
     /// Writing the report failed.
-    #[error("writing {path}: {source}")]
+    #[error("writing {path}")]
     Write {
         /// The file.
         path: PathBuf,
@@ -173,21 +186,26 @@ pub fn run(
         let agent = Binaries::locate_program(LOCKSTEP_AGENT_PROGRAM)?;
         for &robots in &options.sizes {
             check_stop(stop)?;
+            let ticks = (200_000 / robots as usize).clamp(200, 5000);
             let bare_options = BareOptions {
                 robots,
-                ticks: (200_000 / robots as usize).clamp(200, 5000),
+                ticks,
                 windows: 5,
                 world_spin: None,
                 agent_spin: None,
             };
             let measured = bare::run(&agent, &bare_options)
                 .map_err(|source| BenchError::Bare { robots, source })?;
+            check_stop(stop)?;
+            let floor_rate = floor::run(robots, ticks, 5)
+                .map_err(|source| BenchError::Floor { robots, source })?;
             report.bare.push(BareFigures {
                 robots,
                 robot_steps_per_second: measured.robot_steps_per_second,
                 tick_p50_us: measured.tick_p50.as_secs_f64() * 1e6,
                 tick_p99_us: measured.tick_p99.as_secs_f64() * 1e6,
                 first_tick_seconds: measured.first_tick.as_secs_f64(),
+                floor_robot_steps_per_second: floor_rate,
             });
             on_result(&report);
         }
@@ -351,16 +369,19 @@ pub fn markdown(report: &BenchReport) -> String {
     }
     if !report.bare.is_empty() {
         text.push_str(
-            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick |\n|---|---|---|---|---|\n",
+            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick | floor (same hour) | bare / floor |\n\
+             |---|---|---|---|---|---|---|\n",
         );
         for f in &report.bare {
             text.push_str(&format!(
-                "| {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s |\n",
+                "| {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.0} | {:.2} |\n",
                 f.robots,
                 f.robot_steps_per_second,
                 f.tick_p50_us,
                 f.tick_p99_us,
                 f.first_tick_seconds,
+                f.floor_robot_steps_per_second,
+                f.robot_steps_per_second / f.floor_robot_steps_per_second.max(1.0),
             ));
         }
     }

@@ -11,6 +11,7 @@ use super::process_args::{AgentArgs, RunArgs};
 use super::restart::{Ending, RestartTracker};
 use super::run_dir;
 use super::{LaunchError, io};
+use crate::transport::tune_agent_command;
 
 /// Where a robot's agent stands, as the launcher sees it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -127,7 +128,7 @@ impl AgentSpawner {
             .open(&log_path)
             .map_err(io(format!("opening {}", log_path.display())))?;
         children::spawn(
-            Command::new(&self.program)
+            tune_agent_command(&mut Command::new(&self.program))
                 .args(args.to_args())
                 .stdin(Stdio::null())
                 .stdout(Stdio::null())

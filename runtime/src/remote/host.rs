@@ -38,7 +38,7 @@ use crate::launcher::process_args::{AgentArgs, RunArgs};
 use crate::launcher::resume::{ResumeError, ResumePoint};
 use crate::launcher::run_dir;
 use crate::messages::{SensorFrame, SupervisorSnapshot};
-use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink};
+use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink, tune_agent_command};
 
 /// How long agents get to exit by themselves when a share ends.
 const AGENT_EXIT_GRACE: Duration = Duration::from_secs(2);
@@ -499,7 +499,7 @@ impl Share {
             source,
         })?;
         children::spawn(
-            Command::new(&self.agent)
+            tune_agent_command(&mut Command::new(&self.agent))
                 .args(args.to_args())
                 .args(["--slot", &slot.to_string()])
                 .stdin(Stdio::null())

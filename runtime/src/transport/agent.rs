@@ -1,5 +1,6 @@
-//! An agent's side of the lockstep: join a run for one robot, sleep until the world opens a tick, load the
-//! robot's own frame from the frame board, answer by writing the command board of its robot.
+//! An agent's side of the lockstep: join a run for one robot, sleep until a relay hands it an open tick, load
+//! the robot's own frame from the frame board, answer by writing the command board of its robot and hand the
+//! tick on to the next robot of its chain.
 //!
 //! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
 //! never answer a tick the world has not opened yet, nor the same tick twice.
@@ -19,7 +20,7 @@ use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// How long a joining agent waits for the world to replace its robot's command board after a death.
 const BOARD_WAIT: Duration = Duration::from_secs(30);
-/// Default number of polls of the tick word before an agent sleeps on it (see [`AgentLink::set_spin`]).
+/// Default number of polls of the relay word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
 /// One tick's frame of this agent's robot, loaded from the world's frame board.
@@ -55,7 +56,6 @@ struct Ports {
 pub struct AgentLink {
     robot: u32,
     spin: u32,
-    seen_epoch: u32,
     /// The last tick handed out by [`AgentLink::next_tick`] (0: none yet).
     last_tick: u64,
     ports: Ports,
@@ -76,14 +76,12 @@ impl AgentLink {
         }
         match Self::connect(run, robot, &sync) {
             Ok(ports) => {
-                let seen_epoch = sync.epoch();
                 // A replacement agent must not answer a tick its predecessor already answered.
                 let last_tick = sync.tick();
                 sync.announce_ready(robot);
                 Ok(AgentLink {
                     robot,
                     spin: DEFAULT_AGENT_SPIN,
-                    seen_epoch,
                     last_tick,
                     ports,
                     sync,
@@ -156,7 +154,7 @@ impl AgentLink {
         self.robot
     }
 
-    /// How many times the agent polls the tick word before it sleeps on it (default 0: the lockstep benchmark
+    /// How many times the agent polls its relay word before it sleeps on it (default 0: the lockstep benchmark
     /// on 2 cores is fastest without agent polling). Polling only pays when every agent has a core to itself.
     pub fn set_spin(&mut self, polls: u32) {
         self.spin = polls;
@@ -167,6 +165,7 @@ impl AgentLink {
     /// of silence). An agent that fell behind skips straight to the newest tick.
     pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
         loop {
+            let seen = self.sync.relay_word(self.robot);
             if self.sync.stopped() {
                 return Ok(None);
             }
@@ -179,9 +178,8 @@ impl AgentLink {
                     return Ok(Some(TickFrame { frame }));
                 }
             }
-            self.seen_epoch = self
-                .sync
-                .wait_epoch_change(self.seen_epoch, self.spin)
+            self.sync
+                .wait_relay(self.robot, seen, self.spin)
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }
@@ -198,6 +196,7 @@ impl AgentLink {
         answer.tick = tick;
         answer.robot = self.robot;
         self.ports.command_entry.update_with_copy(answer);
+        self.sync.pass_on(self.robot, tick);
         self.sync.claim(self.robot, tick);
         Ok(())
     }

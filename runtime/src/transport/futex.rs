@@ -1,8 +1,7 @@
 //! Linux futex wait/wake on a 32-bit word in shared memory.
 //!
-//! The lockstep protocol parks every agent on one word and wakes them all with one `FUTEX_WAKE` (design.md:
-//! one broadcast is far cheaper than one channel per robot). The word lives in a `MAP_SHARED` mapping, so the
-//! shared (non-private) futex operations are used. This module must never spin: callers decide how long to spin
+//! The lockstep protocol parks each agent on its own word and the world on one counter; the words live in a
+//! `MAP_SHARED` mapping, so the shared (non-private) futex operations are used. This module must never spin: callers decide how long to spin
 //! before they block here.
 
 use std::sync::atomic::AtomicU32;

@@ -1,9 +1,17 @@
 //! The lockstep sync block: a small file in the run's shared memory holding the futex words of the tick protocol
 //! and one slot per robot.
 //!
-//! Only control words live here (tick epoch, acknowledgement counter, join and death flags); frames and commands
+//! Only control words live here (tick, per-robot relay words, acknowledgement counter, join and death flags); frames and commands
 //! travel through iceoryx2 samples. The world creates the block, agents map it. Every field is an atomic, so
 //! the mapping is shared freely between threads and processes; a zero-filled block is a valid empty block.
+//!
+//! Agents are woken by relays rather than by one broadcast: the robots form chains of consecutive indices,
+//! the world wakes each chain's first robot, and every agent that answers wakes the next robot of its chain.
+//! Each agent sleeps on its own `go` word, so a wake-up is a targeted one from the process that just ran,
+//! usually on the same core, instead of one system call that makes every agent runnable at once (measured in
+//! docs/transport.md). A dead robot never breaks its chain: relays step over robots without a live agent, and a
+//! death notice hands the tick on in place of the dead agent; a frozen one is stepped over by the world's rescue
+//! (see [`SyncBlock::rescue`]).
 //!
 //! The acknowledgement word packs the tick it belongs to (top bits) with the number of robots accounted for in
 //! that tick (bottom bits). An answer is counted only while the word still carries its tick, so a late answer
@@ -22,7 +30,7 @@ use super::{TransportError, futex};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 2;
+const LAYOUT_VERSION: u32 = 3;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -44,10 +52,10 @@ struct Header {
     capacity: AtomicU32,
     /// Process id of the world, so that agents notice when it is gone.
     world_pid: AtomicU32,
-    /// Current tick (full width), written before `epoch`.
+    /// Robots per relay chain: chain `c` is robots `c * relay_len ..` up to the next chain's first robot.
+    relay_len: AtomicU32,
+    /// Current tick (full width), written after the tick's frames and before any relay.
     tick: AtomicU64,
-    /// Low 32 bits of the current tick; agents sleep on it.
-    epoch: Line32,
     /// Tick tag and answer count; the world sleeps on it.
     acks: Line32,
     /// Number of robots whose agent has joined; the world sleeps on it while waiting for agents.
@@ -58,9 +66,12 @@ struct Header {
     board_requests: Line32,
 }
 
-/// Per-robot control words.
-#[repr(C)]
+/// Per-robot control words, one cache line per robot: the robot's agent, its predecessor in the chain and the
+/// world write here from different cores.
+#[repr(C, align(64))]
 struct RobotSlot {
+    /// Low 32 bits of the last tick handed to this robot by a relay; its agent sleeps on it.
+    go: AtomicU32,
     /// Last tick this robot was accounted for.
     answered: AtomicU64,
     /// 1 while an agent owns this robot.
@@ -77,6 +88,8 @@ pub(crate) struct SyncBlock {
     base: NonNull<u8>,
     len: usize,
     capacity: u32,
+    /// Robots per relay chain (a copy of the header's, which never changes).
+    relay_len: u32,
 }
 
 // SAFETY: the mapping is only accessed through atomics, and it stays mapped until the SyncBlock is dropped.
@@ -97,8 +110,13 @@ impl SyncBlock {
         size_of::<Header>() + capacity as usize * size_of::<RobotSlot>()
     }
 
-    /// Creates the block of a run for `capacity` robots; fails if it exists.
-    pub(crate) fn create(path: &Path, capacity: u32) -> Result<SyncBlock, TransportError> {
+    /// Creates the block of a run for `capacity` robots woken in chains of `relay_len` robots; fails if it
+    /// exists.
+    pub(crate) fn create(
+        path: &Path,
+        capacity: u32,
+        relay_len: u32,
+    ) -> Result<SyncBlock, TransportError> {
         let io_err = |source| TransportError::SyncBlock {
             path: path.to_path_buf(),
             source,
@@ -111,10 +129,12 @@ impl SyncBlock {
             .map_err(io_err)?;
         let len = Self::size_for(capacity);
         file.set_len(len as u64).map_err(io_err)?;
-        let block = Self::map(path, &file, len, capacity)?;
+        let mut block = Self::map(path, &file, len, capacity)?;
+        block.relay_len = relay_len.max(1);
         let header = block.header();
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
+        header.relay_len.store(relay_len.max(1), Ordering::Relaxed);
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
@@ -169,8 +189,11 @@ impl SyncBlock {
                 "{file_len} bytes cannot hold {capacity} robots ({len} bytes)"
             )));
         }
+        let relay_len = header.relay_len.load(Ordering::Relaxed).max(1);
         drop(header_only);
-        Self::map(path, &file, len, capacity)
+        let mut block = Self::map(path, &file, len, capacity)?;
+        block.relay_len = relay_len;
+        Ok(block)
     }
 
     fn map(
@@ -204,6 +227,7 @@ impl SyncBlock {
             base,
             len,
             capacity,
+            relay_len: 1,
         })
     }
 
@@ -235,17 +259,13 @@ impl SyncBlock {
         self.header().tick.load(Ordering::Acquire)
     }
 
-    /// The current epoch word (low 32 bits of the tick).
-    pub(crate) fn epoch(&self) -> u32 {
-        self.header().epoch.0.load(Ordering::Acquire)
-    }
-
     /// Whether the world has ended the run.
     pub(crate) fn stopped(&self) -> bool {
         self.header().stop.0.load(Ordering::Acquire) != 0
     }
 
     /// Opens tick `tick` for answers: resets the count, then accounts for every robot with a death notice.
+    /// The tick's frames must be in place: from here on an agent may read its frame for `tick`.
     pub(crate) fn open_tick(&self, tick: u64) {
         let header = self.header();
         header
@@ -261,19 +281,75 @@ impl SyncBlock {
         }
     }
 
-    /// Publishes the tick to the agents and wakes all of them with one system call.
-    pub(crate) fn wake_agents(&self, tick: u64) {
-        let epoch = &self.header().epoch.0;
-        epoch.store(tick as u32, Ordering::Release);
-        futex::wake(epoch, i32::MAX);
+    /// Starts the relays of `tick`: wakes the first robot of every chain.
+    pub(crate) fn start_relays(&self, tick: u64) {
+        for first in (0..self.capacity).step_by(self.relay_len as usize) {
+            self.relay_from(first, tick);
+        }
+    }
+
+    /// Hands `tick` on from `robot` to the next robot of its chain, if any; called by the agent that answered
+    /// and by the death notice of an agent that may have died before it could.
+    pub(crate) fn pass_on(&self, robot: u32, tick: u64) {
+        let next = robot + 1;
+        if next < self.capacity && !self.starts_chain(next) {
+            self.relay_from(next, tick);
+        }
+    }
+
+    /// Wakes `robot` for `tick`, and the robots after it in its chain up to the first one with a live agent,
+    /// which relays further itself. Robots without a live agent are still woken: a thawed agent whose death
+    /// notice is not yet withdrawn may answer.
+    fn relay_from(&self, robot: u32, tick: u64) {
+        let mut next = robot;
+        loop {
+            self.wake_robot(next, tick);
+            if self.has_agent(next) {
+                return;
+            }
+            next += 1;
+            if next >= self.capacity || self.starts_chain(next) {
+                return;
+            }
+        }
+    }
+
+    fn starts_chain(&self, robot: u32) -> bool {
+        robot.is_multiple_of(self.relay_len)
+    }
+
+    fn wake_robot(&self, robot: u32, tick: u64) {
+        let go = &self.slot(robot).go;
+        go.store(tick as u32, Ordering::Release);
+        futex::wake(go, i32::MAX);
+    }
+
+    /// The world's remedy for a relay stuck at an agent that neither answers nor has a death notice (frozen,
+    /// or killed and not yet reported): wakes every robot not yet accounted for in `tick` that no relay has
+    /// reached. Returns how many were woken.
+    pub(crate) fn rescue(&self, tick: u64) -> u32 {
+        let mut woken = 0;
+        for robot in 0..self.capacity {
+            let slot = self.slot(robot);
+            if slot.answered.load(Ordering::Acquire) != tick
+                && slot.go.load(Ordering::Acquire) != tick as u32
+            {
+                self.wake_robot(robot, tick);
+                woken += 1;
+            }
+        }
+        woken
     }
 
     /// Ends the run: agents waiting for a tick return.
     pub(crate) fn stop(&self) {
         let header = self.header();
         header.stop.0.store(1, Ordering::Release);
-        header.epoch.0.fetch_add(1, Ordering::AcqRel);
-        futex::wake(&header.epoch.0, i32::MAX);
+        for robot in 0..self.capacity {
+            let go = &self.slot(robot).go;
+            go.fetch_add(1, Ordering::AcqRel);
+            futex::wake(go, i32::MAX);
+        }
     }
 
     /// Accounts for `robot` in `tick` unless it already was; returns whether this call counted it. The call
@@ -306,11 +382,19 @@ impl SyncBlock {
     }
 
     /// Waits until every robot is accounted for in `tick` or `deadline` passes, spinning for at most `spin`
-    /// first. Returns whether every robot was accounted for.
-    pub(crate) fn wait_answers(&self, tick: u64, spin: Duration, deadline: Instant) -> bool {
+    /// first. Whenever no answer arrives for `stall`, robots the relays have not reached are woken directly
+    /// ([`SyncBlock::rescue`]). Returns whether every robot was accounted for.
+    pub(crate) fn wait_answers(
+        &self,
+        tick: u64,
+        spin: Duration,
+        stall: Duration,
+        deadline: Instant,
+    ) -> bool {
         let acks = &self.header().acks.0;
         let complete = tag(tick) << COUNT_BITS | self.capacity;
         let spin_until = Instant::now() + spin;
+        let mut progress = (acks.load(Ordering::Acquire), Instant::now());
         loop {
             let current = acks.load(Ordering::Acquire);
             if current == complete {
@@ -320,10 +404,22 @@ impl SyncBlock {
             if now >= deadline {
                 return false;
             }
+            if current != progress.0 {
+                progress = (current, now);
+            } else if now >= progress.1 + stall {
+                let woken = self.rescue(tick);
+                tracing::debug!(
+                    tick,
+                    woken,
+                    "relay stalled; woke the robots it had not reached"
+                );
+                progress.1 = now;
+            }
             if now < spin_until {
                 std::hint::spin_loop();
             } else {
-                futex::wait(acks, current, Some(deadline - now));
+                let wake_by = deadline.min(progress.1 + stall);
+                futex::wait(acks, current, Some(wake_by.saturating_duration_since(now)));
             }
         }
     }
@@ -336,7 +432,12 @@ impl SyncBlock {
         if slot.owner.swap(0, Ordering::AcqRel) == 1 {
             self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
         }
-        self.claim(robot, self.header().tick.load(Ordering::SeqCst));
+        let tick = self.header().tick.load(Ordering::SeqCst);
+        self.claim(robot, tick);
+        if tick > 0 {
+            // The agent may have died holding the relay: hand the tick on in its place.
+            self.pass_on(robot, tick);
+        }
     }
 
     /// A replacement agent for `robot` asks for a fresh command board: its dead predecessor may still hold the
@@ -464,28 +565,30 @@ impl SyncBlock {
         joined.load(Ordering::Acquire)
     }
 
-    /// Waits until the epoch word differs from `seen` (or the run stops), spinning `spin` times before blocking.
-    /// Every [`WORLD_CHECK`] without a change it checks that the world process still exists; `Err(pid)` when it
-    /// is gone (killed without stopping the run).
-    pub(crate) fn wait_epoch_change(&self, seen: u32, spin: u32) -> Result<u32, u32> {
-        let epoch = &self.header().epoch.0;
+    /// The relay word of `robot`: read it before checking for an open tick, then [`SyncBlock::wait_relay`] on
+    /// the value read, so that no relay between the check and the wait is missed.
+    pub(crate) fn relay_word(&self, robot: u32) -> u32 {
+        self.slot(robot).go.load(Ordering::Acquire)
+    }
+
+    /// Waits until `robot`'s relay word differs from `seen` (a relay, or the end of the run), polling `spin`
+    /// times before blocking. Every [`WORLD_CHECK`] without a change it checks that the world process still
+    /// exists; `Err(pid)` when it is gone (killed without stopping the run).
+    pub(crate) fn wait_relay(&self, robot: u32, seen: u32, spin: u32) -> Result<(), u32> {
+        let go = &self.slot(robot).go;
         for _ in 0..spin {
-            let current = epoch.load(Ordering::Acquire);
-            if current != seen {
-                return Ok(current);
+            if go.load(Ordering::Acquire) != seen {
+                return Ok(());
             }
             std::hint::spin_loop();
         }
-        loop {
-            let current = epoch.load(Ordering::Acquire);
-            if current != seen {
-                return Ok(current);
-            }
-            let waited = futex::wait(epoch, seen, Some(WORLD_CHECK));
+        while go.load(Ordering::Acquire) == seen {
+            let waited = futex::wait(go, seen, Some(WORLD_CHECK));
             if waited == futex::Waited::TimedOut && !self.world_alive() {
                 return Err(self.header().world_pid.load(Ordering::Relaxed));
             }
         }
+        Ok(())
     }
 
     fn world_alive(&self) -> bool {

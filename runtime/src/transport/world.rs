@@ -25,6 +25,9 @@ use crate::messages::{ActuatorCommand, SensorFrame};
 pub const DEFAULT_TICK_DEADLINE: Duration = Duration::from_millis(500);
 /// Default time the world spins before it blocks on the answer counter (see [`LinkConfig::spin`]).
 pub const DEFAULT_SPIN: Duration = Duration::from_micros(20);
+/// Default time without any answer after which the world wakes the robots a stuck relay has not reached (see
+/// [`LinkConfig::relay_stall`]).
+pub const DEFAULT_RELAY_STALL: Duration = Duration::from_millis(5);
 /// Default number of ticks between two dead-node cleanups (see [`LinkConfig::cleanup_interval`]).
 pub const DEFAULT_CLEANUP_INTERVAL: u64 = 1000;
 
@@ -42,6 +45,12 @@ pub struct LinkConfig {
     /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice or a
     /// replacement agent's request triggers one at once as well. Removals run on a thread of their own.
     pub cleanup_interval: u64,
+    /// Number of relay chains the robots are woken in (0: chosen from the robot count, see
+    /// [`LinkConfig::relay_len`]). The world wakes the first robot of each chain; each agent wakes the next.
+    pub relays: u32,
+    /// How long a tick may go without any answer before the world wakes every robot no relay has reached yet
+    /// (default 5 ms): a frozen agent, or one killed before its death notice, holds up its chain until then.
+    pub relay_stall: Duration,
 }
 
 impl LinkConfig {
@@ -52,7 +61,21 @@ impl LinkConfig {
             tick_deadline: DEFAULT_TICK_DEADLINE,
             spin: DEFAULT_SPIN,
             cleanup_interval: DEFAULT_CLEANUP_INTERVAL,
+            relays: 0,
+            relay_stall: DEFAULT_RELAY_STALL,
         }
+    }
+
+    /// Robots per relay chain. Unless [`LinkConfig::relays`] says otherwise, one chain per 100 robots, at
+    /// least 2 and at most 16: the range where the relay beat a single broadcast wake-up on this machine kind
+    /// (docs/transport.md).
+    pub fn relay_len(&self) -> u32 {
+        let robots = self.robots.max(1);
+        let chains = match self.relays {
+            0 => (robots / 100).clamp(2, 16),
+            chosen => chosen,
+        };
+        robots.div_ceil(chains.min(robots))
     }
 }
 
@@ -174,7 +197,11 @@ impl WorldLink {
         let boards = Self::create_boards(&node, robots)?;
         let cleaner = Cleaner::start(run.iceoryx_config()?)?;
         // Last, so that a failure above leaves no sync block behind (iceoryx2 removes its own resources on drop).
-        let sync = Arc::new(SyncBlock::create(&run.sync_block_path(), robots)?);
+        let sync = Arc::new(SyncBlock::create(
+            &run.sync_block_path(),
+            robots,
+            config.relay_len(),
+        )?);
         tracing::debug!(run = run.name(), robots, "world link created");
         Ok(WorldLink {
             tick: 0,
@@ -319,9 +346,9 @@ impl WorldLink {
         let sync = &self.deaths.sync;
         sync.open_tick(tick);
         self.tick = tick;
-        sync.wake_agents(tick);
+        sync.start_relays(tick);
         let deadline = Instant::now() + self.config.tick_deadline;
-        if !sync.wait_answers(tick, self.config.spin, deadline) {
+        if !sync.wait_answers(tick, self.config.spin, self.config.relay_stall, deadline) {
             tracing::debug!(tick, "tick deadline passed with answers missing");
         }
         let outcome = self.collect(tick);
@@ -403,5 +430,30 @@ impl WorldLink {
 impl Drop for WorldLink {
     fn drop(&mut self) {
         self.deaths.sync.stop();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LinkConfig;
+
+    fn relay_len(robots: u32, relays: u32) -> u32 {
+        LinkConfig {
+            relays,
+            ..LinkConfig::new(robots)
+        }
+        .relay_len()
+    }
+
+    #[test]
+    fn chains_follow_the_robot_count_unless_chosen() {
+        assert_eq!(relay_len(1, 0), 1);
+        assert_eq!(relay_len(10, 0), 5);
+        assert_eq!(relay_len(100, 0), 50);
+        assert_eq!(relay_len(1000, 0), 100);
+        assert_eq!(relay_len(2000, 0), 125);
+        assert_eq!(relay_len(5000, 0), 313);
+        assert_eq!(relay_len(8, 3), 3);
+        assert_eq!(relay_len(4, 9), 1);
     }
 }
