@@ -186,3 +186,16 @@ pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<f64, FloorError>
     }
     Ok(median(&rates).unwrap_or(0.0))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::run;
+
+    #[test]
+    fn every_forked_process_answers_every_tick_from_the_first() {
+        // A process that starts after the world opened tick 1 must still answer it, or this fails after
+        // TICK_LIMIT with "tick 1: 3 of 4 processes answered".
+        let rate = run(4, 20, 2).expect("the floor runs");
+        assert!(rate > 0.0);
+    }
+}
