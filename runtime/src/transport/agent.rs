@@ -18,7 +18,8 @@ use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
-/// How long a joining agent waits for the world to replace its robot's command board after a death.
+/// How long a joining agent waits for the death notice of its robot's dead agent, and then for the world to
+/// replace the robot's command board.
 const BOARD_WAIT: Duration = Duration::from_secs(30);
 /// Default number of polls of the relay word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
@@ -71,7 +72,7 @@ impl AgentLink {
         if robot >= capacity {
             return Err(TransportError::RobotOutOfRange { robot, capacity });
         }
-        if let JoinClaim::Taken = sync.claim_robot(robot) {
+        if let JoinClaim::Taken = sync.claim_robot(robot, Instant::now() + BOARD_WAIT) {
             return Err(TransportError::RobotTaken { robot });
         }
         match Self::connect(run, robot, &sync) {

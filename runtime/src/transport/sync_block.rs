@@ -30,13 +30,15 @@ use super::{TransportError, futex};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 3;
+const LAYOUT_VERSION: u32 = 4;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
 const COUNT_MASK: u32 = (1 << COUNT_BITS) - 1;
 /// How long an agent sleeps on the tick word before it checks that the world still exists.
 const WORLD_CHECK: Duration = Duration::from_secs(1);
+/// How often a replacement agent re-checks a claim held by a dead agent while it waits for the death notice.
+const CLAIM_POLL: Duration = Duration::from_millis(10);
 /// Most robots one run can hold (the count field must not overflow into the tick tag).
 pub const MAX_ROBOTS: u32 = COUNT_MASK;
 
@@ -76,6 +78,8 @@ struct RobotSlot {
     answered: AtomicU64,
     /// 1 while an agent owns this robot.
     owner: AtomicU32,
+    /// Process id of the agent that last claimed this robot.
+    owner_pid: AtomicU32,
     /// 1 after a death notice, until a replacement agent joins.
     dead: AtomicU32,
     /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
@@ -432,6 +436,8 @@ impl SyncBlock {
         if slot.owner.swap(0, Ordering::AcqRel) == 1 {
             self.header().joined.0.fetch_sub(1, Ordering::AcqRel);
         }
+        // A replacement may be waiting for the dead agent's claim to be released.
+        futex::wake(&slot.owner, i32::MAX);
         let tick = self.header().tick.load(Ordering::SeqCst);
         self.claim(robot, tick);
         if tick > 0 {
@@ -511,15 +517,25 @@ impl SyncBlock {
         true
     }
 
-    /// An agent claims `robot` before it connects, so that a second agent for the same robot fails fast.
-    pub(crate) fn claim_robot(&self, robot: u32) -> JoinClaim {
-        match self
-            .slot(robot)
-            .owner
-            .compare_exchange(0, 1, Ordering::AcqRel, Ordering::Acquire)
-        {
-            Ok(_) => JoinClaim::Claimed,
-            Err(_) => JoinClaim::Taken,
+    /// An agent claims `robot` before it connects, so that a second agent for the same robot fails fast. A
+    /// claim held by a process that no longer exists is a dead agent whose death notice is still on its way
+    /// (its replacement can start first): that one is waited for until `deadline`.
+    pub(crate) fn claim_robot(&self, robot: u32, deadline: Instant) -> JoinClaim {
+        let slot = self.slot(robot);
+        loop {
+            if slot
+                .owner
+                .compare_exchange(0, 1, Ordering::AcqRel, Ordering::Acquire)
+                .is_ok()
+            {
+                slot.owner_pid.store(std::process::id(), Ordering::Release);
+                return JoinClaim::Claimed;
+            }
+            let now = Instant::now();
+            if now >= deadline || process_exists(slot.owner_pid.load(Ordering::Acquire)) {
+                return JoinClaim::Taken;
+            }
+            futex::wait(&slot.owner, 1, Some((deadline - now).min(CLAIM_POLL)));
         }
     }
 
@@ -592,14 +608,18 @@ impl SyncBlock {
     }
 
     fn world_alive(&self) -> bool {
-        let pid = self.header().world_pid.load(Ordering::Relaxed);
-        let Ok(pid) = libc::pid_t::try_from(pid) else {
-            return false;
-        };
-        // SAFETY: signal 0 only checks that the process exists; nothing is delivered.
-        let result = unsafe { libc::kill(pid, 0) };
-        result == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+        process_exists(self.header().world_pid.load(Ordering::Relaxed))
     }
+}
+
+/// Whether process `pid` exists (a zombie not yet reaped still does).
+fn process_exists(pid: u32) -> bool {
+    let Ok(pid) = libc::pid_t::try_from(pid) else {
+        return false;
+    };
+    // SAFETY: signal 0 only checks that the process exists; nothing is delivered.
+    let result = unsafe { libc::kill(pid, 0) };
+    result == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
 }
 
 impl Drop for SyncBlock {
