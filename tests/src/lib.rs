@@ -221,17 +221,8 @@ pub fn remove_run_leftovers(run_prefix: &str) {
     for path in shm_leftovers(run_prefix) {
         let _ = std::fs::remove_file(path);
     }
-    let root_prefix = format!("iceoryx2-{run_prefix}");
-    if let Ok(entries) = std::fs::read_dir(RUN_ROOTS_DIR) {
-        for entry in entries.flatten() {
-            if entry
-                .file_name()
-                .to_string_lossy()
-                .starts_with(&root_prefix)
-            {
-                let _ = std::fs::remove_dir_all(entry.path());
-            }
-        }
+    for root in iceoryx_root_leftovers(run_prefix) {
+        let _ = std::fs::remove_dir_all(root);
     }
 }
 
@@ -503,23 +494,5 @@ pub fn wipe_runs(run_prefix: &str) {
             );
         }
     }
-    let roots = std::fs::read_dir(RUN_ROOTS_DIR)
-        .map(|entries| entries.flatten().map(|e| e.path()).collect::<Vec<_>>())
-        .unwrap_or_default();
-    for root in roots {
-        let Some(name) = root
-            .file_name()
-            .and_then(|n| n.to_str())
-            .and_then(|n| n.strip_prefix("iceoryx2-"))
-            .filter(|n| n.starts_with(run_prefix))
-        else {
-            continue;
-        };
-        if let Ok(spec) = swarm_runtime::transport::RunSpec::new(name, &root) {
-            let _ = spec.cleanup();
-        }
-    }
-    for file in shm_leftovers(run_prefix) {
-        let _ = std::fs::remove_file(file);
-    }
+    remove_run_leftovers(run_prefix);
 }

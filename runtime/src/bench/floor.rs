@@ -4,27 +4,23 @@
 //! futex-broadcast lockstep of N processes with no work"); measuring it next to the bare lockstep turns the
 //! comparison into a ratio that a noisy machine cannot skew.
 
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use crate::bench::stats::median;
-use crate::transport::futex;
+use crate::transport::futex::{self, LineWord};
 
 /// Ticks run before measuring.
 const WARMUP_TICKS: usize = 100;
 /// A tick that takes longer than this means a child died: give up instead of waiting forever.
 const TICK_LIMIT: Duration = Duration::from_secs(10);
 
-/// One word on its own cache line.
-#[repr(C, align(64))]
-struct Line(AtomicU32);
-
 /// The shared words: the tick the children sleep on, the answer count the world sleeps on, the stop flag.
 #[repr(C)]
 struct Words {
-    epoch: Line,
-    acks: Line,
-    stop: Line,
+    epoch: LineWord,
+    acks: LineWord,
+    stop: LineWord,
 }
 
 /// Why the floor could not be measured.

@@ -369,8 +369,8 @@ pub fn markdown(report: &BenchReport) -> String {
     }
     if !report.bare.is_empty() {
         text.push_str(
-            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick | floor (same hour) | bare / floor |\n\
-             |---|---|---|---|---|---|---|\n",
+            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick | floor (same hour) \
+             | bare / floor |\n|---|---|---|---|---|---|---|\n",
         );
         for f in &report.bare {
             text.push_str(&format!(

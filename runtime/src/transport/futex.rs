@@ -1,8 +1,8 @@
 //! Linux futex wait/wake on a 32-bit word in shared memory.
 //!
 //! The lockstep protocol parks each agent on its own word and the world on one counter; the words live in a
-//! `MAP_SHARED` mapping, so the shared (non-private) futex operations are used. This module must never spin: callers decide how long to spin
-//! before they block here.
+//! `MAP_SHARED` mapping, so the shared (non-private) futex operations are used. This module must never spin:
+//! callers decide how long to spin before they block here.
 
 use std::sync::atomic::AtomicU32;
 use std::time::Duration;
@@ -38,6 +38,11 @@ pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) -> Waite
         Waited::Woken
     }
 }
+
+/// One 32-bit futex word on its own cache line, so that processes polling it do not share a line with writers
+/// of other words.
+#[repr(C, align(64))]
+pub(crate) struct LineWord(pub(crate) AtomicU32);
 
 /// How a [`wait`] ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

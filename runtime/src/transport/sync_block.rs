@@ -1,9 +1,10 @@
 //! The lockstep sync block: a small file in the run's shared memory holding the futex words of the tick protocol
 //! and one slot per robot.
 //!
-//! Only control words live here (tick, per-robot relay words, acknowledgement counter, join and death flags); frames and commands
-//! travel through iceoryx2 samples. The world creates the block, agents map it. Every field is an atomic, so
-//! the mapping is shared freely between threads and processes; a zero-filled block is a valid empty block.
+//! Only control words live here (tick, per-robot relay words, acknowledgement counter, join and death flags);
+//! frames and commands travel through iceoryx2 blackboards. The world creates the block, agents map it. Every
+//! field is an atomic, so the mapping is shared freely between threads and processes; a zero-filled block is a
+//! valid empty block.
 //!
 //! Agents are woken by relays rather than by one broadcast: the robots form chains of consecutive indices,
 //! the world wakes each chain's first robot, and every agent that answers wakes the next robot of its chain.
@@ -25,7 +26,8 @@ use std::ptr::NonNull;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
-use super::{TransportError, futex};
+use super::TransportError;
+use super::futex::{self, LineWord};
 
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
@@ -35,16 +37,12 @@ const LAYOUT_VERSION: u32 = 4;
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
 const COUNT_MASK: u32 = (1 << COUNT_BITS) - 1;
-/// How long an agent sleeps on the tick word before it checks that the world still exists.
+/// How long an agent sleeps on its relay word before it checks that the world still exists.
 const WORLD_CHECK: Duration = Duration::from_secs(1);
 /// How often a replacement agent re-checks a claim held by a dead agent while it waits for the death notice.
 const CLAIM_POLL: Duration = Duration::from_millis(10);
 /// Most robots one run can hold (the count field must not overflow into the tick tag).
 pub const MAX_ROBOTS: u32 = COUNT_MASK;
-
-/// One 32-bit word on its own cache line, so that agents polling it do not share a line with writers of others.
-#[repr(C, align(64))]
-struct Line32(AtomicU32);
 
 /// Fixed part of the block.
 #[repr(C)]
@@ -59,13 +57,13 @@ struct Header {
     /// Current tick (full width), written after the tick's frames and before any relay.
     tick: AtomicU64,
     /// Tick tag and answer count; the world sleeps on it.
-    acks: Line32,
+    acks: LineWord,
     /// Number of robots whose agent has joined; the world sleeps on it while waiting for agents.
-    joined: Line32,
+    joined: LineWord,
     /// Non-zero once the world ends the run.
-    stop: Line32,
+    stop: LineWord,
     /// Count of replacement agents' requests for a fresh command board; the world polls it once per tick.
-    board_requests: Line32,
+    board_requests: LineWord,
 }
 
 /// Per-robot control words, one cache line per robot: the robot's agent, its predecessor in the chain and the
@@ -133,12 +131,11 @@ impl SyncBlock {
             .map_err(io_err)?;
         let len = Self::size_for(capacity);
         file.set_len(len as u64).map_err(io_err)?;
-        let mut block = Self::map(path, &file, len, capacity)?;
-        block.relay_len = relay_len.max(1);
+        let block = Self::map(path, &file, len, capacity, relay_len.max(1))?;
         let header = block.header();
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
-        header.relay_len.store(relay_len.max(1), Ordering::Relaxed);
+        header.relay_len.store(block.relay_len, Ordering::Relaxed);
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
@@ -175,7 +172,7 @@ impl SyncBlock {
                 "{file_len} bytes is too short for a header"
             )));
         }
-        let header_only = Self::map(path, &file, size_of::<Header>(), 0)?;
+        let header_only = Self::map(path, &file, size_of::<Header>(), 0, 1)?;
         let header = header_only.header();
         if header.magic.load(Ordering::Acquire) != MAGIC {
             return Err(invalid("not a swarm lockstep block (bad magic)".into()));
@@ -195,9 +192,7 @@ impl SyncBlock {
         }
         let relay_len = header.relay_len.load(Ordering::Relaxed).max(1);
         drop(header_only);
-        let mut block = Self::map(path, &file, len, capacity)?;
-        block.relay_len = relay_len;
-        Ok(block)
+        Self::map(path, &file, len, capacity, relay_len)
     }
 
     fn map(
@@ -205,6 +200,7 @@ impl SyncBlock {
         file: &std::fs::File,
         len: usize,
         capacity: u32,
+        relay_len: u32,
     ) -> Result<SyncBlock, TransportError> {
         // SAFETY: a fresh shared mapping of an open file descriptor; the kernel picks the address.
         let ptr = unsafe {
@@ -231,7 +227,7 @@ impl SyncBlock {
             base,
             len,
             capacity,
-            relay_len: 1,
+            relay_len,
         })
     }
 
