@@ -19,12 +19,13 @@ fn recorded_run(seed: u64, ticks: u64, dir: &std::path::Path) -> Vec<u8> {
     exp.controllers[0].sensors[0].noise_level = 0.02;
     exp.controllers[0].actuators[0].noise_std_dev = 0.05;
     let mut world = World::new(&exp, seed).expect("builds");
-    let mut recorder = Recorder::create(dir, &[]).expect("recorder");
-    recorder.record_initial(&world).expect("record");
+    let mut recorder = Recorder::create(dir, &world, &[]).expect("recorder");
+    recorder.record(&world).expect("record");
     for _ in 0..ticks {
         world.run_in_process(1, avoid_obstacles);
         recorder.record(&world).expect("record");
     }
+    recorder.sync().expect("written");
     std::fs::read(dir.join("trajectory.csv")).expect("trajectory written")
 }
 
@@ -61,8 +62,8 @@ fn recorder_writes_summary_metrics_and_a_png_snapshot() {
         location: common::config::at(20),
     });
     let mut world = World::new(&exp, 7).expect("builds");
-    let mut recorder = Recorder::create(dir.path(), &[0, 20]).expect("recorder");
-    recorder.record_initial(&world).expect("record");
+    let mut recorder = Recorder::create(dir.path(), &world, &[0, 20]).expect("recorder");
+    recorder.record(&world).expect("record");
     for _ in 0..20 {
         world.run_in_process(1, avoid_obstacles);
         recorder.record(&world).expect("record");

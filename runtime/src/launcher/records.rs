@@ -1,8 +1,8 @@
 //! Making a dead world's records readable: after the world process died, `trajectory.csv` and `events.csv` are
 //! cut back to the last tick the trajectory holds completely (a half-written line or tick is dropped).
 //!
-//! The world flushes both files at the end of every tick, so this only ever removes what a kill in the middle
-//! of writing left behind. It never touches the records of a run whose world finished normally.
+//! The world's recorder thread flushes a tick's events before its poses, so this only ever removes what a kill
+//! in the middle of writing left behind. It never touches the records of a run whose world finished normally.
 
 use std::path::Path;
 

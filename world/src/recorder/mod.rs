@@ -1,16 +1,24 @@
-//! The run record: `trajectory.csv` (one row per robot per tick), `summary.json` (the loop functions' metrics
-//! and run facts) and PNG snapshots at chosen ticks.
+//! The run record: `trajectory.csv` (one row per robot per tick), `events.csv` (every fired event and fault),
+//! `summary.json` (the loop functions' metrics and run facts) and PNG snapshots at chosen ticks.
 //!
-//! Rows go through a buffered writer that is flushed at the end of every tick, so a crash loses at most the tick
-//! being written. Recording reads the world and never changes it.
+//! The tick loop only copies plain rows; a thread of the recorder's own formats, writes and flushes them, one
+//! batch per tick ([`background`], [`files`]). Recording reads the world and never changes it.
 
+pub mod background;
+pub mod events;
+pub mod files;
 pub mod snapshot;
 pub mod trajectory;
 
-pub use trajectory::{TRAJECTORY_FILE, TrajectoryWriter};
+pub use background::{Background, RowWriter};
+pub use events::{EVENTS_FILE, EventRow, EventsWriter};
+pub use files::{RecordFiles, RecordRow};
+pub use trajectory::{PoseRow, TRAJECTORY_FILE, TrajectoryWriter};
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+
+use swarm_runtime::messages::ActuatorCommand;
 
 use crate::error::WorldError;
 use crate::world::World;
@@ -21,33 +29,55 @@ pub const SUMMARY_FILE: &str = "summary.json";
 /// Records one run into a directory.
 pub struct Recorder {
     dir: PathBuf,
-    trajectory: TrajectoryWriter,
+    files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
 }
 
 impl Recorder {
-    /// Creates `dir` (if needed) and its `trajectory.csv`; snapshots are drawn after each tick in `snapshot_ticks`
-    /// (tick 0 is the initial placement, drawn by [`Recorder::record_initial`]).
-    pub fn create(dir: &Path, snapshot_ticks: &[u64]) -> Result<Self, WorldError> {
+    /// Creates `dir` (if needed) and its `trajectory.csv` and `events.csv` for `world`'s robots (event names
+    /// from the launcher's event tables in `dir`, if any); snapshots are drawn after each tick in
+    /// `snapshot_ticks` (tick 0 is the initial placement: record it before the first tick).
+    pub fn create(dir: &Path, world: &World, snapshot_ticks: &[u64]) -> Result<Self, WorldError> {
         std::fs::create_dir_all(dir).map_err(|source| WorldError::Io {
             path: dir.to_path_buf(),
             source,
         })?;
+        let files = RecordFiles {
+            events: EventsWriter::create(dir, &world.arena)?,
+            trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
+        };
         Ok(Self {
             dir: dir.to_path_buf(),
-            trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE))?,
+            files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
         })
     }
 
-    /// Records the initial placement (tick 0).
-    pub fn record_initial(&mut self, world: &World) -> Result<(), WorldError> {
-        self.record(world)
+    /// Records the events `robot`'s command reports as fired.
+    pub fn record_command(&mut self, robot: usize, command: &ActuatorCommand) {
+        for &event in command.fired_events() {
+            self.files.push(RecordRow::Event(EventRow::Fired {
+                tick: command.tick,
+                robot: robot as u32,
+                event,
+            }));
+        }
     }
 
-    /// Records the world's current tick: trajectory rows (flushed), and a snapshot if this tick is scheduled.
+    /// Records a fault row: `name` (e.g. `fault:kill`) in the event column, taking effect at `tick`.
+    pub fn record_fault(&mut self, tick: u64, robot: usize, name: &'static str) {
+        self.files.push(RecordRow::Event(EventRow::Fault {
+            tick,
+            robot: robot as u32,
+            name,
+        }));
+    }
+
+    /// Ends the world's current tick: its trajectory rows and the events recorded since the last tick go to
+    /// the writing thread, and a snapshot is drawn if this tick is scheduled.
     pub fn record(&mut self, world: &World) -> Result<(), WorldError> {
-        self.trajectory.write_tick(&world.arena)?;
+        PoseRow::capture(&world.arena, |row| self.files.push(RecordRow::Pose(row)));
+        self.files.end_batch()?;
         let tick = world.tick();
         if self.snapshot_ticks.contains(&tick) {
             snapshot::render(world, &self.dir.join(format!("snapshot_{tick:06}.png")))?;
@@ -55,14 +85,16 @@ impl Recorder {
         Ok(())
     }
 
-    /// Writes `summary.json`: the metrics of the loop functions under `metrics`, the run facts, and `extra`
-    /// merged in at the top level. Returns the file's path.
-    pub fn finish(
-        &mut self,
-        world: &World,
-        extra: serde_json::Value,
-    ) -> Result<PathBuf, WorldError> {
-        self.trajectory.flush()?;
+    /// Returns once every row recorded so far is in its file. The world calls it before the launcher applies
+    /// a fault (a scheduled world kill must find every earlier tick recorded).
+    pub fn sync(&mut self) -> Result<(), WorldError> {
+        self.files.sync()
+    }
+
+    /// Writes the rest of `trajectory.csv` and `events.csv`, then `summary.json`: the metrics of the loop functions under
+    /// `metrics`, the run facts, and `extra` merged in at the top level. Returns the summary's path.
+    pub fn finish(self, world: &World, extra: serde_json::Value) -> Result<PathBuf, WorldError> {
+        self.files.finish()?;
         let mut summary = serde_json::json!({
             "ticks": world.tick(),
             "ticks_per_second": world.arena.ticks_per_second,

@@ -5,6 +5,8 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use swarm_runtime::messages::Rgb;
+
 use crate::arena::Arena;
 use crate::error::WorldError;
 
@@ -13,15 +15,49 @@ pub const TRAJECTORY_FILE: &str = "trajectory.csv";
 /// The header line.
 pub const TRAJECTORY_HEADER: &str = "tick,robot,x,y,heading,led_r,led_g,led_b,alive";
 
+/// One robot's row of one tick, before formatting.
+#[derive(Clone, Copy, Debug)]
+pub struct PoseRow {
+    tick: u64,
+    robot: u32,
+    x: f32,
+    y: f32,
+    heading: f32,
+    led: Rgb,
+    alive: bool,
+}
+
+impl PoseRow {
+    /// Every robot's row for the arena's current tick, appended to `rows`.
+    pub fn capture(arena: &Arena, rows: impl FnMut(PoseRow)) {
+        arena
+            .robots
+            .iter()
+            .enumerate()
+            .map(|(robot, r)| PoseRow {
+                tick: arena.tick,
+                robot: robot as u32,
+                x: r.position.x,
+                y: r.position.y,
+                heading: r.heading,
+                led: r.led,
+                alive: r.alive,
+            })
+            .for_each(rows);
+    }
+}
+
 /// A buffered trajectory file.
 pub struct TrajectoryWriter {
     path: PathBuf,
     out: BufWriter<File>,
+    /// The configuration's robot ids, by robot index.
+    names: Vec<String>,
 }
 
 impl TrajectoryWriter {
-    /// Creates (truncates) the file and writes the header.
-    pub fn create(path: &Path) -> Result<Self, WorldError> {
+    /// Creates (truncates) the file for the arena's robots and writes the header.
+    pub fn create(path: &Path, arena: &Arena) -> Result<Self, WorldError> {
         let file = File::create(path).map_err(|source| WorldError::Io {
             path: path.to_path_buf(),
             source,
@@ -29,6 +65,7 @@ impl TrajectoryWriter {
         let mut writer = Self {
             path: path.to_path_buf(),
             out: BufWriter::with_capacity(1 << 16, file),
+            names: arena.robots.iter().map(|r| r.name.clone()).collect(),
         };
         writeln!(writer.out, "{TRAJECTORY_HEADER}").map_err(|source| writer.error(source))?;
         Ok(writer)
@@ -41,29 +78,32 @@ impl TrajectoryWriter {
         }
     }
 
-    /// Writes every robot's row for the arena's current tick and flushes.
-    pub fn write_tick(&mut self, arena: &Arena) -> Result<(), WorldError> {
-        for r in &arena.robots {
-            writeln!(
-                self.out,
-                "{},{},{},{},{},{},{},{},{}",
-                arena.tick,
-                r.name,
-                r.position.x,
-                r.position.y,
-                r.heading,
-                r.led.r,
-                r.led.g,
-                r.led.b,
-                u8::from(r.alive)
-            )
-            .map_err(|source| self.error(source))?;
-        }
-        self.flush()
+    /// Formats `row` into the file's buffer.
+    pub fn write_row(&mut self, row: &PoseRow) -> Result<(), WorldError> {
+        self.format(row).map_err(|source| self.error(source))
     }
 
-    /// Flushes the buffer to the file.
+    /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
         self.out.flush().map_err(|source| self.error(source))
+    }
+
+    fn format(&mut self, row: &PoseRow) -> std::io::Result<()> {
+        let name = self
+            .names
+            .get(row.robot as usize)
+            .map_or("", String::as_str);
+        writeln!(
+            self.out,
+            "{},{name},{},{},{},{},{},{},{}",
+            row.tick,
+            row.x,
+            row.y,
+            row.heading,
+            row.led.r,
+            row.led.g,
+            row.led.b,
+            u8::from(row.alive)
+        )
     }
 }

@@ -10,7 +10,6 @@
 //! the flags are documented by `swarm-world --help`. With hosts (`--hosts` or `<hosts>`), the robots run on
 //! `swarm host` daemons reached over zenoh instead ([`remote`]).
 
-mod events;
 mod faults;
 mod pacing;
 mod remote;
@@ -33,7 +32,6 @@ use swarm_runtime::transport::{LinkConfig, RunSpec, WorldLink};
 use swarm_world::World;
 use swarm_world::recorder::Recorder;
 
-use events::EventsWriter;
 use faults::FaultDriver;
 use pacing::Pacer;
 use remote::Link;
@@ -123,9 +121,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         args.out.clone(),
         Duration::from_millis(args.join_timeout_ms),
     )?;
-    let mut recorder = Recorder::create(&args.out, &[0, args.ticks])?;
-    let mut events = EventsWriter::create(&args.out, &roster)?;
-    recorder.record_initial(&world)?;
+    let mut records = Recorder::create(&args.out, &world, &[0, args.ticks])?;
+    records.record(&world)?;
     report(WorldReport::Ready {
         robots: robots as u32,
     });
@@ -133,7 +130,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
-    faults.wait_for_agents(&mut link, &mut world, &mut events, &commands)?;
+    faults.wait_for_agents(&mut link, &mut world, &mut records, &commands)?;
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -150,7 +147,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             link.tick() + 1,
             &mut link,
             &mut world,
-            &mut events,
+            &mut records,
             &commands,
         )?;
         let tick_started = Instant::now();
@@ -163,14 +160,13 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 Some(command) => {
                     commands[robot] = *command;
                     has_command[robot] = true;
-                    events.record(robot, command)?;
+                    records.record_command(robot, command);
                 }
                 None => has_command[robot] = false,
             }
         }
         world.act_and_step(&commands, &has_command);
-        recorder.record(&world)?;
-        events.flush()?;
+        records.record(&world)?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);
         commands_missing += u64::from(outcome.missing);
@@ -202,8 +198,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             object.insert("hosts".into(), hosts);
         }
     }
-    recorder.finish(&world, extra)?;
-    events.flush()?;
+    records.finish(&world, extra)?;
     report(WorldReport::Finished { ticks });
     Ok(())
 }

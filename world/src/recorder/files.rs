@@ -1,0 +1,42 @@
+//! The per-tick record files as the recorder's thread writes them: `events.csv` and `trajectory.csv` together.
+//!
+//! A tick's batch ends with its poses, and the events file is flushed before the trajectory file. So whenever
+//! the trajectory holds a tick for every robot, the events of that tick are on disk too: the launcher's cut-back
+//! after a world death (`runtime/src/launcher/records.rs`) trusts the trajectory to say which ticks are whole.
+
+use super::background::RowWriter;
+use super::events::{EventRow, EventsWriter};
+use super::trajectory::{PoseRow, TrajectoryWriter};
+use crate::error::WorldError;
+
+/// One row of either file.
+#[derive(Clone, Copy, Debug)]
+pub enum RecordRow {
+    /// A row of `events.csv`.
+    Event(EventRow),
+    /// A row of `trajectory.csv`.
+    Pose(PoseRow),
+}
+
+/// Both files.
+pub struct RecordFiles {
+    /// `events.csv`.
+    pub events: EventsWriter,
+    /// `trajectory.csv`.
+    pub trajectory: TrajectoryWriter,
+}
+
+impl RowWriter for RecordFiles {
+    type Row = RecordRow;
+
+    fn write_batch(&mut self, rows: &[RecordRow]) -> Result<(), WorldError> {
+        for row in rows {
+            match row {
+                RecordRow::Event(row) => self.events.write_row(row)?,
+                RecordRow::Pose(row) => self.trajectory.write_row(row)?,
+            }
+        }
+        self.events.flush()?;
+        self.trajectory.flush()
+    }
+}
