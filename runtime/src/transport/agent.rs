@@ -5,6 +5,7 @@
 //! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
 //! never answer a tick the world has not opened yet, nor the same tick twice.
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
@@ -16,6 +17,7 @@ use super::TransportError;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
+use super::world_watch::WorldWatch;
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// How long a joining agent waits for the death notice of its robot's dead agent, and then for the world to
@@ -60,14 +62,16 @@ pub struct AgentLink {
     /// The last tick handed out by [`AgentLink::next_tick`] (0: none yet).
     last_tick: u64,
     ports: Ports,
-    sync: SyncBlock,
+    sync: Arc<SyncBlock>,
+    /// Notices the end of the world process, so that waits need no timeout (`None`: no pidfd here).
+    world_watch: Option<WorldWatch>,
 }
 
 impl AgentLink {
     /// Joins `run` as the agent of `robot`. Fails with a message naming the limit when the run has no place for
     /// it, or when another live agent already runs this robot.
     pub fn join(run: &RunSpec, robot: u32) -> Result<AgentLink, TransportError> {
-        let sync = SyncBlock::open(&run.sync_block_path())?;
+        let sync = Arc::new(SyncBlock::open(&run.sync_block_path())?);
         let capacity = sync.capacity();
         if robot >= capacity {
             return Err(TransportError::RobotOutOfRange { robot, capacity });
@@ -79,6 +83,8 @@ impl AgentLink {
             Ok(ports) => {
                 // A replacement agent must not answer a tick its predecessor already answered.
                 let last_tick = sync.tick();
+                let watched = Arc::clone(&sync);
+                let world_watch = WorldWatch::start(sync.world_pid(), move || watched.nudge(robot));
                 sync.announce_ready(robot);
                 Ok(AgentLink {
                     robot,
@@ -86,6 +92,7 @@ impl AgentLink {
                     last_tick,
                     ports,
                     sync,
+                    world_watch,
                 })
             }
             Err(e) => {
@@ -162,8 +169,8 @@ impl AgentLink {
     }
 
     /// Waits for the next tick the world opens and returns this robot's frame; `None` when the world ended the
-    /// run, [`TransportError::WorldGone`] when the world process died without ending it (checked every second
-    /// of silence). An agent that fell behind skips straight to the newest tick.
+    /// run, [`TransportError::WorldGone`] when the world process died without ending it. An agent that fell
+    /// behind skips straight to the newest tick.
     pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
         loop {
             let seen = self.sync.relay_word(self.robot);
@@ -179,8 +186,9 @@ impl AgentLink {
                     return Ok(Some(TickFrame { frame }));
                 }
             }
+            let world_gone = self.world_watch.as_ref().map(WorldWatch::gone);
             self.sync
-                .wait_relay(self.robot, seen, self.spin)
+                .wait_relay(self.robot, seen, self.spin, world_gone)
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }

@@ -18,6 +18,7 @@ mod run;
 mod services;
 mod sync_block;
 mod world;
+mod world_watch;
 
 use std::path::PathBuf;
 use std::process::Command;

@@ -23,7 +23,7 @@ use std::fs::OpenOptions;
 use std::os::fd::AsRawFd;
 use std::path::{Path, PathBuf};
 use std::ptr::NonNull;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use super::TransportError;
@@ -584,9 +584,17 @@ impl SyncBlock {
     }
 
     /// Waits until `robot`'s relay word differs from `seen` (a relay, or the end of the run), polling `spin`
-    /// times before blocking. Every [`WORLD_CHECK`] without a change it checks that the world process still
-    /// exists; `Err(pid)` when it is gone (killed without stopping the run).
-    pub(crate) fn wait_relay(&self, robot: u32, seen: u32, spin: u32) -> Result<(), u32> {
+    /// times before blocking; `Err(pid)` when the world process is gone (killed without stopping the run).
+    /// With `world_gone` (set by a [`WorldWatch`](super::world_watch::WorldWatch), which also changes the
+    /// relay word) it sleeps without a timeout; without, it checks every [`WORLD_CHECK`] of silence that the
+    /// world process still exists.
+    pub(crate) fn wait_relay(
+        &self,
+        robot: u32,
+        seen: u32,
+        spin: u32,
+        world_gone: Option<&AtomicBool>,
+    ) -> Result<(), u32> {
         let go = &self.slot(robot).go;
         for _ in 0..spin {
             if go.load(Ordering::Acquire) != seen {
@@ -595,16 +603,39 @@ impl SyncBlock {
             std::hint::spin_loop();
         }
         while go.load(Ordering::Acquire) == seen {
-            let waited = futex::wait(go, seen, Some(WORLD_CHECK));
-            if waited == futex::Waited::TimedOut && !self.world_alive() {
-                return Err(self.header().world_pid.load(Ordering::Relaxed));
+            let gone = match world_gone {
+                Some(gone) if gone.load(Ordering::Acquire) => true,
+                Some(_) => {
+                    futex::wait(go, seen, None);
+                    false
+                }
+                None => {
+                    futex::wait(go, seen, Some(WORLD_CHECK)) == futex::Waited::TimedOut
+                        && !self.world_alive()
+                }
+            };
+            if gone {
+                return Err(self.world_pid());
             }
         }
         Ok(())
     }
 
+    /// Wakes `robot`'s agent out of [`SyncBlock::wait_relay`] by changing its relay word (only when the world is
+    /// gone: then the word's value means nothing any more).
+    pub(crate) fn nudge(&self, robot: u32) {
+        let go = &self.slot(robot).go;
+        go.fetch_add(1, Ordering::AcqRel);
+        futex::wake(go, i32::MAX);
+    }
+
+    /// The pid of the process that created the block.
+    pub(crate) fn world_pid(&self) -> u32 {
+        self.header().world_pid.load(Ordering::Relaxed)
+    }
+
     fn world_alive(&self) -> bool {
-        process_exists(self.header().world_pid.load(Ordering::Relaxed))
+        process_exists(self.world_pid())
     }
 }
 
