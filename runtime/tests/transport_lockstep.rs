@@ -278,3 +278,101 @@ fn replacement_agent_joins_after_a_death_notice_and_answers_again() {
     assert_eq!(outcome.answered, 3, "{outcome:?}");
     expect_echo(&world, 1, 4);
 }
+
+/// Names the run a [`world_process_for_the_world_death_test`] process is the world of.
+const WORLD_RUN_ENV: &str = "SWARM_TEST_WORLD_RUN";
+/// The iceoryx2 root directory of that run.
+const WORLD_ROOT_ENV: &str = "SWARM_TEST_WORLD_ROOT";
+
+/// Not a test of its own: when [`an_agent_exits_on_its_own_when_the_world_process_dies`] starts this test binary
+/// again with [`WORLD_RUN_ENV`] set, this is its world process (one robot, one tick, then it waits to be killed).
+/// Run any other way, it returns at once.
+#[test]
+fn world_process_for_the_world_death_test() {
+    let (Ok(name), Ok(root)) = (std::env::var(WORLD_RUN_ENV), std::env::var(WORLD_ROOT_ENV)) else {
+        return;
+    };
+    let spec = RunSpec::new(&name, root).expect("run spec");
+    let mut world = WorldLink::create(&spec, config(1, 10_000)).expect("create world");
+    println!("world ready");
+    world
+        .wait_for_agents(JOIN_TIMEOUT)
+        .expect("the agent joins");
+    assert_eq!(world.tick_with(sense).expect("tick").answered, 1);
+    println!("world ticked");
+    loop {
+        std::thread::park();
+    }
+}
+
+#[test]
+fn an_agent_exits_on_its_own_when_the_world_process_dies() {
+    use std::io::{BufRead, BufReader, Read};
+
+    let mut run = Run::new();
+    let world = Command::new(std::env::current_exe().expect("the test binary"))
+        .args([
+            "--exact",
+            "world_process_for_the_world_death_test",
+            "--nocapture",
+        ])
+        .env(WORLD_RUN_ENV, run.spec.name())
+        .env(WORLD_ROOT_ENV, run.spec.root_dir())
+        .stdout(Stdio::piped())
+        .stdin(Stdio::null())
+        .spawn()
+        .expect("start the world process");
+    run.children.push(world);
+    let mut world_says = BufReader::new(run.children[0].stdout.take().expect("piped")).lines();
+    let mut wait_for = |line: &str| {
+        world_says
+            .by_ref()
+            .map(|l| l.expect("the world's output"))
+            .find(|l| l == line)
+            .unwrap_or_else(|| panic!("the world process ended before saying '{line}'"));
+    };
+    wait_for("world ready");
+    let agent = Command::new(AGENT)
+        .arg("--run")
+        .arg(run.spec.name())
+        .arg("--root")
+        .arg(run.spec.root_dir())
+        .args(["--robot", "0"])
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn the lockstep agent");
+    run.children.push(agent);
+    wait_for("world ticked");
+
+    run.children[0].kill().expect("SIGKILL the world");
+    let _ = run.children[0].wait();
+    // Only a guard against a hang: the agent is expected to exit by itself long before. It cannot hit another
+    // process: the agent's pid stays taken until the wait below has reaped it, and that ends the guard.
+    let (exited, guard_ends) = std::sync::mpsc::channel::<()>();
+    let agent_pid = run.children[1].id().to_string();
+    let guard = std::thread::spawn(move || {
+        if guard_ends.recv_timeout(Duration::from_secs(60)).is_err() {
+            let _ = Command::new("kill").args(["-KILL", &agent_pid]).status();
+        }
+    });
+    let status = run.children[1].wait().expect("wait for the agent");
+    let _ = exited.send(());
+    let _ = guard.join();
+    let mut stderr = String::new();
+    run.children[1]
+        .stderr
+        .take()
+        .expect("piped")
+        .read_to_string(&mut stderr)
+        .expect("the agent's error output");
+    assert_eq!(
+        status.code(),
+        Some(1),
+        "the agent ends with an error of its own, not a signal: {status:?} {stderr}"
+    );
+    assert!(
+        stderr.contains("is gone without ending the run"),
+        "the agent says why: {stderr}"
+    );
+}
