@@ -5,6 +5,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::bench::cpu::total_cpu;
 use crate::bench::stats::{median, quantile};
 use crate::transport::{LinkConfig, RunSpec, TransportError, WorldLink, tune_agent_command};
 
@@ -39,6 +40,8 @@ pub struct BareReport {
     pub tick_p50: Duration,
     /// 99th-percentile tick time.
     pub tick_p99: Duration,
+    /// CPU time of the world and every agent per robot-step, over all windows ([`crate::bench::cpu`]).
+    pub cpu_per_robot_step: Duration,
 }
 
 /// Why the bare benchmark failed.
@@ -133,6 +136,8 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
     let mut p50s = Vec::with_capacity(options.windows);
     let mut p99s = Vec::with_capacity(options.windows);
     let mut times = Vec::with_capacity(options.ticks);
+    let agent_pids = || agents.children.iter().map(Child::id);
+    let cpu_before = total_cpu(agent_pids());
     for _ in 0..options.windows.max(1) {
         times.clear();
         let window = Instant::now();
@@ -147,6 +152,10 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
         p50s.push(quantile(&times, 0.5).unwrap_or_default().as_secs_f64());
         p99s.push(quantile(&times, 0.99).unwrap_or_default().as_secs_f64());
     }
+    let robot_steps = f64::from(robots) * (options.ticks.max(1) * options.windows.max(1)) as f64;
+    let cpu_per_robot_step = total_cpu(agent_pids())
+        .saturating_sub(cpu_before)
+        .div_f64(robot_steps);
     drop(world);
     drop(agents);
     let leftovers = run.leftovers();
@@ -159,6 +168,7 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
         robot_steps_per_second: median(&rates).unwrap_or(0.0),
         tick_p50: Duration::from_secs_f64(median(&p50s).unwrap_or(0.0)),
         tick_p99: Duration::from_secs_f64(median(&p99s).unwrap_or(0.0)),
+        cpu_per_robot_step,
     })
 }
 

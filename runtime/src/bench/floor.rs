@@ -7,6 +7,7 @@
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
+use crate::bench::cpu::total_cpu;
 use crate::bench::stats::median;
 use crate::transport::futex::{self, LineWord};
 
@@ -104,9 +105,17 @@ fn child(words: &Words, robots: u32) -> ! {
     }
 }
 
-/// Measures the floor with `robots` processes: robot-steps per second, the median over `windows` windows of
-/// `ticks` ticks.
-pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<f64, FloorError> {
+/// What the floor measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FloorReport {
+    /// Robot-steps per second, the median over the windows.
+    pub robot_steps_per_second: f64,
+    /// CPU time of this process and every child per robot-step, over all windows ([`crate::bench::cpu`]).
+    pub cpu_per_robot_step: Duration,
+}
+
+/// Measures the floor with `robots` processes over `windows` windows of `ticks` ticks.
+pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<FloorReport, FloorError> {
     // SAFETY: a fresh anonymous shared mapping; zero-filled memory is a valid `Words`.
     let mapping = unsafe {
         libc::mmap(
@@ -173,6 +182,13 @@ pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<f64, FloorError>
         step()?;
     }
     let mut rates = Vec::with_capacity(windows);
+    let child_pids = || {
+        floor
+            .children
+            .iter()
+            .filter_map(|&pid| u32::try_from(pid).ok())
+    };
+    let cpu_before = total_cpu(child_pids());
     for _ in 0..windows.max(1) {
         let window = Instant::now();
         for _ in 0..ticks.max(1) {
@@ -180,7 +196,13 @@ pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<f64, FloorError>
         }
         rates.push(f64::from(robots) * ticks.max(1) as f64 / window.elapsed().as_secs_f64());
     }
-    Ok(median(&rates).unwrap_or(0.0))
+    let robot_steps = f64::from(robots) * (ticks.max(1) * windows.max(1)) as f64;
+    Ok(FloorReport {
+        robot_steps_per_second: median(&rates).unwrap_or(0.0),
+        cpu_per_robot_step: total_cpu(child_pids())
+            .saturating_sub(cpu_before)
+            .div_f64(robot_steps),
+    })
 }
 
 #[cfg(test)]
@@ -191,7 +213,7 @@ mod tests {
     fn every_forked_process_answers_every_tick_from_the_first() {
         // A process that starts after the world opened tick 1 must still answer it, or this fails after
         // TICK_LIMIT with "tick 1: 3 of 4 processes answered".
-        let rate = run(4, 20, 2).expect("the floor runs");
-        assert!(rate > 0.0);
+        let report = run(4, 20, 2).expect("the floor runs");
+        assert!(report.robot_steps_per_second > 0.0);
     }
 }

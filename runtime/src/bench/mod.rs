@@ -8,6 +8,7 @@
 //! paced run (e.g. 2,000 agents at 10 ticks/s) and whether every tick kept its slot.
 
 pub mod bare;
+pub mod cpu;
 pub mod floor;
 pub mod rss;
 pub mod stats;
@@ -85,8 +86,12 @@ pub struct BareFigures {
     pub tick_p99_us: f64,
     /// Seconds from spawning the agents to the end of the first tick.
     pub first_tick_seconds: f64,
+    /// CPU time of the world and every agent per robot-step over the windows, in microseconds.
+    pub cpu_us_per_robot_step: f64,
     /// Robot-steps per second of the minimal futex-broadcast lockstep, measured right after ([`floor`]).
     pub floor_robot_steps_per_second: f64,
+    /// The floor's CPU time per robot-step, in microseconds.
+    pub floor_cpu_us_per_robot_step: f64,
 }
 
 /// The real-time check.
@@ -197,7 +202,7 @@ pub fn run(
             let measured = bare::run(&agent, &bare_options)
                 .map_err(|source| BenchError::Bare { robots, source })?;
             check_stop(stop)?;
-            let floor_rate = floor::run(robots, ticks, 5)
+            let floor = floor::run(robots, ticks, 5)
                 .map_err(|source| BenchError::Floor { robots, source })?;
             report.bare.push(BareFigures {
                 robots,
@@ -205,7 +210,9 @@ pub fn run(
                 tick_p50_us: measured.tick_p50.as_secs_f64() * 1e6,
                 tick_p99_us: measured.tick_p99.as_secs_f64() * 1e6,
                 first_tick_seconds: measured.first_tick.as_secs_f64(),
-                floor_robot_steps_per_second: floor_rate,
+                cpu_us_per_robot_step: measured.cpu_per_robot_step.as_secs_f64() * 1e6,
+                floor_robot_steps_per_second: floor.robot_steps_per_second,
+                floor_cpu_us_per_robot_step: floor.cpu_per_robot_step.as_secs_f64() * 1e6,
             });
             on_result(&report);
         }
@@ -369,18 +376,20 @@ pub fn markdown(report: &BenchReport) -> String {
     }
     if !report.bare.is_empty() {
         text.push_str(
-            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick | floor (same hour) \
-             | bare / floor |\n|---|---|---|---|---|---|---|\n",
+            "\n| N (bare lockstep) | robot-steps/s | tick p50 | tick p99 | first tick | CPU per robot-step \
+             | floor (same hour) | floor CPU per robot-step | bare / floor |\n|---|---|---|---|---|---|---|---|---|\n",
         );
         for f in &report.bare {
             text.push_str(&format!(
-                "| {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.0} | {:.2} |\n",
+                "| {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.1} µs | {:.0} | {:.1} µs | {:.2} |\n",
                 f.robots,
                 f.robot_steps_per_second,
                 f.tick_p50_us,
                 f.tick_p99_us,
                 f.first_tick_seconds,
+                f.cpu_us_per_robot_step,
                 f.floor_robot_steps_per_second,
+                f.floor_cpu_us_per_robot_step,
                 f.robot_steps_per_second / f.floor_robot_steps_per_second.max(1.0),
             ));
         }
