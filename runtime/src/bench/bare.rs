@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::bench::cpu::total_cpu;
+use crate::bench::cpu::CpuMark;
 use crate::bench::stats::{median, quantile};
 use crate::transport::{LinkConfig, RunSpec, TransportError, WorldLink, tune_agent_command};
 
@@ -137,7 +137,7 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
     let mut p99s = Vec::with_capacity(options.windows);
     let mut times = Vec::with_capacity(options.ticks);
     let agent_pids = || agents.children.iter().map(Child::id);
-    let cpu_before = total_cpu(agent_pids());
+    let cpu = CpuMark::take(agent_pids());
     for _ in 0..options.windows.max(1) {
         times.clear();
         let window = Instant::now();
@@ -153,9 +153,7 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
         p99s.push(quantile(&times, 0.99).unwrap_or_default().as_secs_f64());
     }
     let robot_steps = f64::from(robots) * (options.ticks.max(1) * options.windows.max(1)) as f64;
-    let cpu_per_robot_step = total_cpu(agent_pids())
-        .saturating_sub(cpu_before)
-        .div_f64(robot_steps);
+    let cpu_per_robot_step = cpu.per_step(agent_pids(), robot_steps);
     drop(world);
     drop(agents);
     let leftovers = run.leftovers();

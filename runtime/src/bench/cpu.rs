@@ -7,18 +7,37 @@
 
 use std::time::Duration;
 
-/// User plus system CPU time of process `pid` so far; `None` when it is gone or its stat is unreadable.
-pub fn process_cpu(pid: u32) -> Option<Duration> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
-    cpu_from_stat(&stat, clock_ticks_per_second())
+/// The CPU time a set of processes had used when it was taken; [`CpuMark::per_step`] turns the time used since
+/// into CPU per robot-step.
+pub struct CpuMark(Duration);
+
+impl CpuMark {
+    /// Marks the CPU time used so far by this process and `pids`.
+    pub fn take(pids: impl IntoIterator<Item = u32>) -> CpuMark {
+        CpuMark(total_cpu(pids))
+    }
+
+    /// The CPU time this process and `pids` used since the mark, divided by `robot_steps`.
+    pub fn per_step(&self, pids: impl IntoIterator<Item = u32>, robot_steps: f64) -> Duration {
+        total_cpu(pids)
+            .saturating_sub(self.0)
+            .div_f64(robot_steps.max(1.0))
+    }
 }
 
 /// The summed CPU time of this process and `pids` (processes that are gone count nothing).
-pub fn total_cpu(pids: impl IntoIterator<Item = u32>) -> Duration {
+fn total_cpu(pids: impl IntoIterator<Item = u32>) -> Duration {
+    let ticks_per_second = clock_ticks_per_second();
     std::iter::once(std::process::id())
         .chain(pids)
-        .filter_map(process_cpu)
+        .filter_map(|pid| process_cpu(pid, ticks_per_second))
         .sum()
+}
+
+/// User plus system CPU time of process `pid` so far; `None` when it is gone or its stat is unreadable.
+fn process_cpu(pid: u32, ticks_per_second: u64) -> Option<Duration> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    cpu_from_stat(&stat, ticks_per_second)
 }
 
 /// utime + stime of a `/proc/<pid>/stat` line: fields 14 and 15, counted after the parenthesised command name
@@ -28,11 +47,9 @@ fn cpu_from_stat(stat: &str, ticks_per_second: u64) -> Option<Duration> {
     let mut fields = after_name.split_whitespace().skip(11);
     let utime: u64 = fields.next()?.parse().ok()?;
     let stime: u64 = fields.next()?.parse().ok()?;
-    let ticks = utime + stime;
-    Some(
-        Duration::from_secs(ticks / ticks_per_second)
-            + Duration::from_secs_f64((ticks % ticks_per_second) as f64 / ticks_per_second as f64),
-    )
+    Some(Duration::from_secs_f64(
+        (utime + stime) as f64 / ticks_per_second as f64,
+    ))
 }
 
 fn clock_ticks_per_second() -> u64 {
@@ -55,7 +72,7 @@ mod tests {
 
     #[test]
     fn a_live_process_has_a_cpu_time_and_a_missing_one_none() {
-        assert!(process_cpu(std::process::id()).is_some());
-        assert_eq!(process_cpu(u32::MAX), None);
+        assert!(process_cpu(std::process::id(), 100).is_some());
+        assert_eq!(process_cpu(u32::MAX, 100), None);
     }
 }

@@ -7,7 +7,7 @@
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use crate::bench::cpu::total_cpu;
+use crate::bench::cpu::CpuMark;
 use crate::bench::stats::median;
 use crate::transport::futex::{self, LineWord};
 
@@ -188,7 +188,7 @@ pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<FloorReport, Flo
             .iter()
             .filter_map(|&pid| u32::try_from(pid).ok())
     };
-    let cpu_before = total_cpu(child_pids());
+    let cpu = CpuMark::take(child_pids());
     for _ in 0..windows.max(1) {
         let window = Instant::now();
         for _ in 0..ticks.max(1) {
@@ -199,9 +199,7 @@ pub fn run(robots: u32, ticks: usize, windows: usize) -> Result<FloorReport, Flo
     let robot_steps = f64::from(robots) * (ticks.max(1) * windows.max(1)) as f64;
     Ok(FloorReport {
         robot_steps_per_second: median(&rates).unwrap_or(0.0),
-        cpu_per_robot_step: total_cpu(child_pids())
-            .saturating_sub(cpu_before)
-            .div_f64(robot_steps),
+        cpu_per_robot_step: cpu.per_step(child_pids(), robot_steps),
     })
 }
 

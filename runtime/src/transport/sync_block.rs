@@ -346,9 +346,7 @@ impl SyncBlock {
         let header = self.header();
         header.stop.0.store(1, Ordering::Release);
         for robot in 0..self.capacity {
-            let go = &self.slot(robot).go;
-            go.fetch_add(1, Ordering::AcqRel);
-            futex::wake(go, i32::MAX);
+            self.nudge(robot);
         }
     }
 
@@ -621,8 +619,8 @@ impl SyncBlock {
         Ok(())
     }
 
-    /// Wakes `robot`'s agent out of [`SyncBlock::wait_relay`] by changing its relay word (only when the world is
-    /// gone: then the word's value means nothing any more).
+    /// Wakes `robot`'s agent out of [`SyncBlock::wait_relay`] by changing its relay word. Only for the end of a
+    /// run (stopped, or the world gone), when the word's value means nothing any more.
     pub(crate) fn nudge(&self, robot: u32) {
         let go = &self.slot(robot).go;
         go.fetch_add(1, Ordering::AcqRel);

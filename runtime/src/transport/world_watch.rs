@@ -1,8 +1,8 @@
 //! Noticing that the world process ended, without a timed wait on the tick path.
 //!
 //! An agent sleeps on its relay word between ticks. A timed futex wait arms and cancels a kernel timer on every
-//! tick, which cost ~9 % of the bare lockstep at N = 1,000 (BENCHMARKS.md), so agents sleep without a timeout
-//! and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the world process,
+//! tick (the bare lockstep at N = 1,000 had a ~3 % lower tick p50 without it, BENCHMARKS.md), so agents sleep
+//! without a timeout and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the world process,
 //! and when the world ends it sets [`WorldWatch::gone`] and calls the agent's wake-up. Where no pidfd can be had
 //! (kernels before 5.3), [`WorldWatch::start`] returns `None` and the caller keeps a timed wait.
 
@@ -24,7 +24,7 @@ pub(crate) struct WorldWatch {
 
 impl WorldWatch {
     /// Starts watching process `pid`; `wake` runs once on the watching thread after [`WorldWatch::gone`] became
-    /// true. `None` when the kernel gives no pidfd for `pid` and no thread could be started; a process that is
+    /// true. `None` when the kernel gives no pidfd for `pid` or no thread could be started; a process that is
     /// already gone counts as gone at once.
     pub(crate) fn start(pid: u32, wake: impl FnOnce() + Send + 'static) -> Option<WorldWatch> {
         let gone = Arc::new(AtomicBool::new(false));

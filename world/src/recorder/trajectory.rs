@@ -28,7 +28,7 @@ pub struct PoseRow {
 }
 
 impl PoseRow {
-    /// Every robot's row for the arena's current tick, appended to `rows`.
+    /// Hands every robot's row for the arena's current tick to `rows`, in robot order.
     pub fn capture(arena: &Arena, rows: impl FnMut(PoseRow)) {
         arena
             .robots

@@ -38,10 +38,10 @@ use swarm_runtime::remote::world_bridge::RobotNews;
 use swarm_runtime::transport::{CommandStatus, DeathNotices};
 use swarm_world::World;
 use swarm_world::entities::RobotId;
+use swarm_world::recorder::Recorder;
 
 use crate::remote::{Link, Stop};
 use crate::report;
-use swarm_world::recorder::Recorder;
 
 /// How long the world waits for the launcher to apply the faults of a tick.
 const APPLY_TIMEOUT: Duration = Duration::from_secs(30);
@@ -187,15 +187,15 @@ impl FaultDriver {
         &mut self,
         link: &mut Link,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         if let Link::Remote(_) = link {
             link.wait(self.join_timeout)?;
             for robot in self.startup_kills.clone() {
                 link.stop(robot, Stop::Kill)?;
-                self.mark_down(robot, Down::Killed, 0, world, records, commands)?;
-                records.record_fault(0, robot as usize, "fault:kill");
+                self.mark_down(robot, Down::Killed, 0, world, recorder, commands)?;
+                recorder.record_fault(0, robot as usize, "fault:kill");
                 report(WorldReport::Fault {
                     tick: 0,
                     kind: FaultKind::Kill,
@@ -203,7 +203,7 @@ impl FaultDriver {
                 });
             }
             if !self.startup_kills.is_empty() {
-                records.sync()?;
+                recorder.sync()?;
                 report(WorldReport::Await { tick: 0 });
                 self.wait_applied(0)?;
                 self.respawn_requested(link, commands)?;
@@ -216,10 +216,10 @@ impl FaultDriver {
             for robot in std::mem::take(&mut self.notices) {
                 if self.robots[robot as usize] == Robot::Alive {
                     if self.startup_kills.contains(&robot) {
-                        self.mark_down(robot, Down::Killed, 0, world, records, commands)?;
-                        records.record_fault(0, robot as usize, "fault:kill");
+                        self.mark_down(robot, Down::Killed, 0, world, recorder, commands)?;
+                        recorder.record_fault(0, robot as usize, "fault:kill");
                     } else {
-                        self.mark_down(robot, Down::Notice, 0, world, records, commands)?;
+                        self.mark_down(robot, Down::Notice, 0, world, recorder, commands)?;
                     }
                 }
             }
@@ -246,7 +246,7 @@ impl FaultDriver {
         tick: u64,
         link: &mut Link,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         self.drain();
@@ -254,11 +254,11 @@ impl FaultDriver {
             link.kill_host(host as usize)?;
         }
         self.respawn_requested(link, commands)?;
-        self.hosts_news(tick, link, world, records, commands)?;
+        self.hosts_news(tick, link, world, recorder, commands)?;
         for robot in std::mem::take(&mut self.notices) {
             match self.robots[robot as usize] {
                 Robot::Alive => {
-                    self.mark_down(robot, Down::Notice, tick, world, records, commands)?;
+                    self.mark_down(robot, Down::Notice, tick, world, recorder, commands)?;
                 }
                 Robot::Down(Down::Deadline | Down::Frozen) => {
                     self.robots[robot as usize] = Robot::Down(Down::Notice);
@@ -277,7 +277,7 @@ impl FaultDriver {
                 match self.robots[robot as usize] {
                     Robot::Alive if status == CommandStatus::Missing => {
                         link.stop(robot, Stop::Skip)?;
-                        self.mark_down(robot, Down::Deadline, tick, world, records, commands)?;
+                        self.mark_down(robot, Down::Deadline, tick, world, recorder, commands)?;
                         report(WorldReport::Down {
                             tick,
                             robot,
@@ -287,7 +287,7 @@ impl FaultDriver {
                     Robot::Down(Down::Deadline)
                         if link.command(robot).is_some() && link.revive(robot, false)? =>
                     {
-                        self.mark_up(robot, tick, world, records)?;
+                        self.mark_up(robot, tick, world, recorder)?;
                     }
                     _ => {}
                 }
@@ -306,18 +306,18 @@ impl FaultDriver {
                 Some(at) if at == tick => {
                     self.rejoin_at[r] = None;
                     if self.wait_for_replacement(robot, link)? {
-                        self.mark_up(robot, tick, world, records)?;
+                        self.mark_up(robot, tick, world, recorder)?;
                     }
                 }
                 _ => {
                     if self.restart_due[r] && link.agent_present(robot) {
                         self.rejoin_at[r] = None;
-                        self.mark_up(robot, tick, world, records)?;
+                        self.mark_up(robot, tick, world, recorder)?;
                     }
                 }
             }
         }
-        self.scheduled(tick, link, world, records, commands)
+        self.scheduled(tick, link, world, recorder, commands)
     }
 
     /// Takes in the launcher's restarts; on hosts, has each robot's host start the replacement from the robot's
@@ -346,7 +346,7 @@ impl FaultDriver {
         tick: u64,
         link: &mut Link,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         link.take_news(&mut self.news);
@@ -358,7 +358,7 @@ impl FaultDriver {
                         self.robots[robot as usize],
                         Robot::Alive | Robot::Down(Down::Frozen | Down::Deadline)
                     ) {
-                        self.mark_down(robot, Down::HostLost, tick, world, records, commands)?;
+                        self.mark_down(robot, Down::HostLost, tick, world, recorder, commands)?;
                         report(WorldReport::Down {
                             tick,
                             robot,
@@ -384,7 +384,7 @@ impl FaultDriver {
         tick: u64,
         link: &mut Link,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         if self.plan.next_due(tick) != Some(tick) {
@@ -424,15 +424,15 @@ impl FaultDriver {
                     // A frozen robot's agent is killed too (on a host, by its host).
                     link.stop(robot, Stop::Kill)?;
                     if self.robots[robot as usize] == Robot::Alive {
-                        self.mark_down(robot, Down::Killed, tick, world, records, commands)?;
+                        self.mark_down(robot, Down::Killed, tick, world, recorder, commands)?;
                     }
                     self.robots[robot as usize] = Robot::Down(Down::Killed);
-                    records.record_fault(tick, robot as usize, "fault:kill");
+                    recorder.record_fault(tick, robot as usize, "fault:kill");
                 }
                 (FaultKind::Freeze, Some(robot)) => {
                     link.stop(robot, Stop::Freeze)?;
-                    self.mark_down(robot, Down::Frozen, tick, world, records, commands)?;
-                    records.record_fault(tick, robot as usize, "fault:freeze");
+                    self.mark_down(robot, Down::Frozen, tick, world, recorder, commands)?;
+                    recorder.record_fault(tick, robot as usize, "fault:freeze");
                 }
                 (FaultKind::Thaw, Some(robot)) => thawed.push(robot),
                 _ => {}
@@ -448,14 +448,14 @@ impl FaultDriver {
         if !reported {
             return Ok(());
         }
-        records.sync()?;
+        recorder.sync()?;
         report(WorldReport::Await { tick });
         self.wait_applied(tick)?;
         self.respawn_requested(link, commands)?;
         for robot in thawed {
             if link.revive(robot, true)? {
-                records.record_fault(tick, robot as usize, "fault:thaw");
-                self.mark_up(robot, tick, world, records)?;
+                recorder.record_fault(tick, robot as usize, "fault:thaw");
+                self.mark_up(robot, tick, world, recorder)?;
             } else {
                 tracing::warn!(robot, tick, "a thawed robot's agent is gone; it stays dead");
                 self.robots[robot as usize] = Robot::Down(Down::Notice);
@@ -471,7 +471,7 @@ impl FaultDriver {
         cause: Down,
         tick: u64,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
         commands: &[ActuatorCommand],
     ) -> anyhow::Result<()> {
         self.robots[robot as usize] = Robot::Down(cause);
@@ -490,7 +490,7 @@ impl FaultDriver {
             Down::Deadline => "fault:missed",
             Down::HostLost => "fault:host-lost",
         };
-        records.record_fault(tick, robot as usize, name);
+        recorder.record_fault(tick, robot as usize, name);
         Ok(())
     }
 
@@ -500,12 +500,12 @@ impl FaultDriver {
         robot: u32,
         tick: u64,
         world: &mut World,
-        records: &mut Recorder,
+        recorder: &mut Recorder,
     ) -> anyhow::Result<()> {
         self.robots[robot as usize] = Robot::Alive;
         self.restart_due[robot as usize] = false;
         world.set_alive(RobotId(robot), true);
-        records.record_fault(tick, robot as usize, "fault:up");
+        recorder.record_fault(tick, robot as usize, "fault:up");
         report(WorldReport::Up { tick, robot });
         Ok(())
     }

@@ -121,8 +121,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         args.out.clone(),
         Duration::from_millis(args.join_timeout_ms),
     )?;
-    let mut records = Recorder::create(&args.out, &world, &[0, args.ticks])?;
-    records.record(&world)?;
+    let mut recorder = Recorder::create(&args.out, &world, &[0, args.ticks])?;
+    recorder.record(&world)?;
     report(WorldReport::Ready {
         robots: robots as u32,
     });
@@ -130,7 +130,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
-    faults.wait_for_agents(&mut link, &mut world, &mut records, &commands)?;
+    faults.wait_for_agents(&mut link, &mut world, &mut recorder, &commands)?;
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -147,7 +147,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             link.tick() + 1,
             &mut link,
             &mut world,
-            &mut records,
+            &mut recorder,
             &commands,
         )?;
         let tick_started = Instant::now();
@@ -160,13 +160,13 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 Some(command) => {
                     commands[robot] = *command;
                     has_command[robot] = true;
-                    records.record_command(robot, command);
+                    recorder.record_command(robot, command);
                 }
                 None => has_command[robot] = false,
             }
         }
         world.act_and_step(&commands, &has_command);
-        records.record(&world)?;
+        recorder.record(&world)?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);
         commands_missing += u64::from(outcome.missing);
@@ -198,7 +198,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             object.insert("hosts".into(), hosts);
         }
     }
-    records.finish(&world, extra)?;
+    recorder.finish(&world, extra)?;
     report(WorldReport::Finished { ticks });
     Ok(())
 }
