@@ -85,8 +85,9 @@ impl Recorder {
         Ok(())
     }
 
-    /// Returns once every row recorded so far is in its file. The world calls it before the launcher applies
-    /// a fault (a scheduled world kill must find every earlier tick recorded).
+    /// Returns once every row recorded so far is in its file. The world calls it before it reports a scheduled
+    /// world kill (the launcher kills it on that report) and before the launcher applies any other fault, so a
+    /// world killed by its schedule leaves every earlier tick recorded.
     pub fn sync(&mut self) -> Result<(), WorldError> {
         self.files.sync()
     }

@@ -435,6 +435,9 @@ impl FaultDriver {
                     recorder.record_fault(tick, robot as usize, "fault:freeze");
                 }
                 (FaultKind::Thaw, Some(robot)) => thawed.push(robot),
+                // The launcher kills the world as soon as it reads this report, so every earlier tick must
+                // be in the files first.
+                (FaultKind::KillWorld, _) => recorder.sync()?,
                 _ => {}
             }
             reported = true;
