@@ -8,7 +8,9 @@
 use std::os::unix::process::CommandExt;
 use std::process::{Child, Command, ExitStatus};
 
+use nix::errno::Errno;
 use nix::sys::signal::{Signal, kill};
+use nix::sys::wait::{Id, WaitPidFlag, WaitStatus, waitid};
 use nix::unistd::Pid;
 
 /// Starts `command` as a supervised child: own process group, killed with the launcher.
@@ -30,6 +32,15 @@ pub fn signal(child: &Child, signal: Signal) {
     }
 }
 
+/// Whether some child of this process has exited and waits to be reaped: one system call, which reaps nothing.
+fn a_child_exited() -> bool {
+    let flags = WaitPidFlag::WEXITED | WaitPidFlag::WNOHANG | WaitPidFlag::WNOWAIT;
+    !matches!(
+        waitid(Id::All, flags),
+        Ok(WaitStatus::StillAlive) | Err(Errno::ECHILD)
+    )
+}
+
 /// A run's processes: the world and one agent per robot (by robot index).
 #[derive(Debug, Default)]
 pub struct Children {
@@ -43,6 +54,10 @@ impl Children {
     /// Agents that exited since the last call, with their robot index and exit status (reaped).
     pub fn reap_agents(&mut self) -> Vec<(u32, ExitStatus)> {
         let mut exited = Vec::new();
+        // Asking each of 1,000 agents every supervision period cost the launcher 2-3 % of a core.
+        if !a_child_exited() {
+            return exited;
+        }
         for (robot, slot) in self.agents.iter_mut().enumerate() {
             if let Some(child) = slot
                 && let Ok(Some(status)) = child.try_wait()
