@@ -1,9 +1,12 @@
-//! CPU time of a set of processes, read from `/proc/<pid>/stat` (user + system time).
+//! CPU time of a set of processes, read from `/proc/<pid>/task/<tid>/schedstat`: the scheduler's own sum of the
+//! time each thread ran, in nanoseconds.
 //!
 //! Throughput on a shared virtual machine swings by 10 % and more between minutes, with the hypervisor's steal
-//! time; the CPU time the kernel charges to the processes themselves moves much less (steal is not charged to
-//! them), so CPU time per robot-step ranks changes that throughput pairs cannot. The kernel accounts in clock
-//! ticks (usually 10 ms), so only sums over many processes and seconds are meaningful.
+//! time; the CPU time the scheduler charges to the processes themselves moves less, so CPU time per robot-step
+//! can rank changes that throughput pairs cannot. `utime` and `stime` of `/proc/<pid>/stat` are no use here:
+//! they are sampled at the timer tick, and an agent that runs for microseconds per tick is mostly missed (they
+//! once read 0.7 µs per robot-step for a run that kept both cores busy). Threads that end between two marks
+//! take their time with them; the agents' threads live as long as the agents.
 
 use std::time::Duration;
 
@@ -27,35 +30,29 @@ impl CpuMark {
 
 /// The summed CPU time of this process and `pids` (processes that are gone count nothing).
 fn total_cpu(pids: impl IntoIterator<Item = u32>) -> Duration {
-    let ticks_per_second = clock_ticks_per_second();
     std::iter::once(std::process::id())
         .chain(pids)
-        .filter_map(|pid| process_cpu(pid, ticks_per_second))
+        .map(process_cpu)
         .sum()
 }
 
-/// User plus system CPU time of process `pid` so far; `None` when it is gone or its stat is unreadable.
-fn process_cpu(pid: u32, ticks_per_second: u64) -> Option<Duration> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
-    cpu_from_stat(&stat, ticks_per_second)
+/// CPU time of every live thread of process `pid` so far; zero when it is gone.
+fn process_cpu(pid: u32) -> Duration {
+    let Ok(threads) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return Duration::ZERO;
+    };
+    threads
+        .filter_map(|thread| {
+            let text = std::fs::read_to_string(thread.ok()?.path().join("schedstat")).ok()?;
+            ran_for(&text)
+        })
+        .sum()
 }
 
-/// utime + stime of a `/proc/<pid>/stat` line: fields 14 and 15, counted after the parenthesised command name
-/// (which may itself hold spaces and parentheses).
-fn cpu_from_stat(stat: &str, ticks_per_second: u64) -> Option<Duration> {
-    let after_name = &stat[stat.rfind(')')? + 1..];
-    let mut fields = after_name.split_whitespace().skip(11);
-    let utime: u64 = fields.next()?.parse().ok()?;
-    let stime: u64 = fields.next()?.parse().ok()?;
-    Some(Duration::from_secs_f64(
-        (utime + stime) as f64 / ticks_per_second as f64,
-    ))
-}
-
-fn clock_ticks_per_second() -> u64 {
-    // SAFETY: sysconf only reads a configuration value.
-    let ticks = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
-    u64::try_from(ticks).ok().filter(|&t| t > 0).unwrap_or(100)
+/// The first field of a `schedstat` line: nanoseconds on a CPU.
+fn ran_for(schedstat: &str) -> Option<Duration> {
+    let nanos = schedstat.split_whitespace().next()?.parse().ok()?;
+    Some(Duration::from_nanos(nanos))
 }
 
 #[cfg(test)]
@@ -63,16 +60,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn user_and_system_ticks_are_read_after_the_command_name() {
-        let stat =
-            "4242 (a (b) c) S 1 4242 4242 0 -1 4194560 100 0 0 0 250 125 0 0 20 0 1 0 100 0 0";
-        assert_eq!(cpu_from_stat(stat, 100), Some(Duration::from_millis(3750)));
-        assert_eq!(cpu_from_stat("garbage", 100), None);
+    fn the_first_schedstat_field_is_the_time_on_a_cpu() {
+        assert_eq!(
+            ran_for("511542364 234877448 995\n"),
+            Some(Duration::from_nanos(511_542_364))
+        );
+        assert_eq!(ran_for("garbage"), None);
     }
 
     #[test]
-    fn a_live_process_has_a_cpu_time_and_a_missing_one_none() {
-        assert!(process_cpu(std::process::id(), 100).is_some());
-        assert_eq!(process_cpu(u32::MAX, 100), None);
+    fn a_busy_process_has_a_cpu_time_and_a_missing_one_none() {
+        let before = process_cpu(std::process::id());
+        // Busy for several scheduler ticks, so that the kernel has brought the running thread's sum up to date.
+        let busy_until = std::time::Instant::now() + Duration::from_millis(30);
+        let mut x = 0u64;
+        while std::time::Instant::now() < busy_until {
+            x = std::hint::black_box(x.wrapping_mul(31).wrapping_add(1));
+        }
+        assert!(process_cpu(std::process::id()) > before);
+        assert_eq!(process_cpu(u32::MAX), Duration::ZERO);
     }
 }
