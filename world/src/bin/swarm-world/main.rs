@@ -121,7 +121,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         args.out.clone(),
         Duration::from_millis(args.join_timeout_ms),
     )?;
-    let mut recorder = Recorder::create(&args.out, &world, &[0, args.ticks])?;
+    let mut recorder = Recorder::create(&args.out, &world, &[0])?;
     recorder.record(&world)?;
     report(WorldReport::Ready {
         robots: robots as u32,
