@@ -2,9 +2,9 @@
 //!
 //! An agent sleeps on its relay word between ticks. A timed futex wait arms and cancels a kernel timer on every
 //! tick (the bare lockstep at N = 1,000 had a ~3 % lower tick p50 without it, BENCHMARKS.md), so agents sleep
-//! without a timeout and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the world process,
-//! and when the world ends it sets [`WorldWatch::gone`] and calls the agent's wake-up. Where no pidfd can be had
-//! (kernels before 5.3), [`WorldWatch::start`] returns `None` and the caller keeps a timed wait.
+//! without a timeout and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the
+//! world process, and when the world ends it sets [`WorldWatch::gone`] and calls the agent's wake-up. Where no
+//! pidfd can be had (kernels before 5.3), [`WorldWatch::start`] returns `None` and the caller keeps a timed wait.
 
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::sync::Arc;
