@@ -51,9 +51,13 @@ impl Drop for Run {
 }
 
 /// Robot 0 sees an obstacle on its right (sensor 7), robot 1 on its left (sensor 0).
-fn sense(_tick: u64, frames: &mut [SensorFrame]) {
-    frames[0].proximity[7] = 0.8;
-    frames[1].proximity[0] = 0.5;
+fn sense(_tick: u64, first: usize, frames: &mut [SensorFrame]) {
+    for (robot, frame) in (first..).zip(frames.iter_mut()) {
+        match robot {
+            0 => frame.proximity[7] = 0.8,
+            _ => frame.proximity[0] = 0.5,
+        }
+    }
 }
 
 #[test]

@@ -57,8 +57,8 @@ impl Drop for Run {
 }
 
 /// The world writes a per-robot, per-tick marker into each frame; the agent echoes it as its wheel speeds.
-fn sense(tick: u64, frames: &mut [swarm_runtime::messages::SensorFrame]) {
-    for (robot, frame) in frames.iter_mut().enumerate() {
+fn sense(tick: u64, first: usize, frames: &mut [swarm_runtime::messages::SensorFrame]) {
+    for (robot, frame) in (first..).zip(frames.iter_mut()) {
         frame.position = [robot as f32 * 10.0 + 1.0, tick as f32];
     }
 }
@@ -145,8 +145,8 @@ fn death_notice_from_another_thread_releases_the_waiting_tick() {
         notices.mark_dead(1).expect("death notice");
     });
     let outcome = world
-        .tick_with(|tick, frames| {
-            sense(tick, frames);
+        .tick_with(|tick, first, frames| {
+            sense(tick, first, frames);
             started_tx.send(()).expect("notify");
         })
         .expect("tick 2");
@@ -203,6 +203,41 @@ fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after
     world.mark_dead(1).expect("death notice");
     let outcome = world.tick_with(sense).expect("tick 5");
     assert_eq!((outcome.answered, outcome.dead), (7, 1));
+}
+
+#[test]
+fn death_notice_for_a_chain_not_yet_started_wakes_nobody_before_their_frames_are_in_place() {
+    let mut run = Run::new();
+    // Two chains of four: 0-1-2-3 and 4-5-6-7. Robot 5's agent stops answering at tick 2 and its death notice
+    // arrives while the world is still sensing chain 0: chain 1 must step over robot 5 when it starts, and
+    // robots 6 and 7 answer with their own frames. (The sync block's unit test checks that the notice wakes
+    // nobody in chain 1 early, which this race seldom shows.)
+    let mut link_config = config(8, 20_000);
+    link_config.relays = 2;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..8 {
+        let extra: &[&str] = if robot == 5 {
+            &["--freeze-at", "2"]
+        } else {
+            &[]
+        };
+        run.spawn(robot, extra);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    let notices = world.death_notices();
+    let outcome = world
+        .tick_with(|tick, first, frames| {
+            if first == 0 {
+                notices.mark_dead(5).expect("death notice");
+            }
+            sense(tick, first, frames);
+        })
+        .expect("tick 2");
+    assert_eq!((outcome.answered, outcome.missing, outcome.dead), (7, 0, 1));
+    for robot in [0, 1, 2, 3, 4, 6, 7] {
+        expect_echo(&world, robot, 2);
+    }
 }
 
 #[test]

@@ -313,6 +313,14 @@ impl World {
 
     /// Fills every robot's frame for the coming tick (`frames[i]` for robot i; extra frames are left alone).
     pub fn sense(&mut self, frames: &mut [SensorFrame]) {
+        self.sense_robots(0, frames);
+    }
+
+    /// Fills the frames of robots `first..` for the coming tick (`frames[i]` for robot `first + i`; frames
+    /// past the last robot are left alone). A robot's frame depends on the world's state and its own sensor
+    /// noise streams only, so sensing the robots in parts, in any order, gives the frames [`World::sense`]
+    /// gives.
+    pub fn sense_robots(&mut self, first: usize, frames: &mut [SensorFrame]) {
         let tick = self.arena.tick + 1;
         let arena = &mut self.arena;
         let floor = |p: Vec2| {
@@ -320,8 +328,8 @@ impl World {
                 .floor_color(p)
                 .unwrap_or_else(|| floor_grey(&arena.floor, p))
         };
-        for (i, (robot, frame)) in arena.robots.iter_mut().zip(frames.iter_mut()).enumerate() {
-            let me = i as u32;
+        let robots = arena.robots.iter_mut().skip(first);
+        for (me, (robot, frame)) in (first as u32..).zip(robots.zip(frames.iter_mut())) {
             if !robot.alive {
                 // A dead robot senses nothing; its frame only says so.
                 *frame = SensorFrame::empty(me);

@@ -3,9 +3,10 @@
 use std::path::PathBuf;
 
 use swarm_runtime::config::Experiment;
-use swarm_runtime::messages::SensorFrame;
+use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::World;
 use swarm_world::entities::TargetState;
+use swarm_world::in_process::avoid_obstacles;
 
 fn load(relative: &str) -> Experiment {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -69,5 +70,37 @@ fn foraging_file_starts_robots_on_the_black_home_strip_with_the_lights_in_view()
             f.light.iter().any(|&l| l > 0.0),
             "every robot in home senses a home light"
         );
+    }
+}
+
+#[test]
+fn sensing_in_parts_in_any_order_gives_the_frames_of_sensing_all_at_once() {
+    for config in [
+        "configs/foraging/foraging.argos",
+        "configs/pheromone_foraging/pheromone_foraging.argos",
+    ] {
+        let exp = load(config);
+        let mut whole = World::new(&exp, 7).expect("builds");
+        let mut parts = World::new(&exp, 7).expect("builds");
+        let n = whole.robot_count();
+        let mut expected: Vec<SensorFrame> = (0..n as u32).map(SensorFrame::empty).collect();
+        let mut frames = expected.clone();
+        let mut commands: Vec<ActuatorCommand> =
+            (0..n as u32).map(|r| ActuatorCommand::idle(r, 0)).collect();
+        let has = vec![true; n];
+        for tick in 0..40 {
+            whole.sense(&mut expected);
+            let starts: Vec<usize> = (0..n).step_by(7).collect();
+            for &first in starts.iter().rev() {
+                let end = (first + 7).min(n);
+                parts.sense_robots(first, &mut frames[first..end]);
+            }
+            assert_eq!(frames, expected, "{config}, tick {tick}");
+            for (f, c) in expected.iter().zip(commands.iter_mut()) {
+                avoid_obstacles(f, c);
+            }
+            whole.act_and_step(&commands, &has);
+            parts.act_and_step(&commands, &has);
+        }
     }
 }

@@ -171,7 +171,7 @@ pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError>
 }
 
 fn tick_all(world: &mut WorldLink, robots: u32) -> Result<(), BareError> {
-    let outcome = world.tick_with(|_, _| {})?;
+    let outcome = world.tick_with(|_, _, _| {})?;
     if outcome.answered == robots {
         Ok(())
     } else {

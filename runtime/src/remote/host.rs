@@ -701,7 +701,9 @@ impl Share {
         };
         let frames = &self.frames;
         link.start_at(header.tick);
-        link.tick_with(|_, local| local.copy_from_slice(frames))?;
+        link.tick_with(|_, first, local| {
+            local.copy_from_slice(&frames[first..first + local.len()]);
+        })?;
         for (slot, reply) in self.replies.iter_mut().enumerate() {
             // `Dead` means the process ended: an agent the world froze or stopped waiting for is `Missing`.
             *reply = match (link.statuses()[slot], link.command(slot as u32)) {

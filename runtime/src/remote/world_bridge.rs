@@ -363,11 +363,13 @@ impl RemoteHosts {
         self.tick
     }
 
-    /// Runs one tick: `sense` fills every robot's frame, one message per live host goes out, and the call returns
-    /// when every live host answered or the deadline passed. Read the commands with [`RemoteHosts::command`].
+    /// Runs one tick: `sense(tick, 0, frames)` fills every robot's frame (the arguments of
+    /// `WorldLink::tick_with`, with all robots at once), one message per live host goes out, and the call
+    /// returns when every live host answered or the deadline passed. Read the commands with
+    /// [`RemoteHosts::command`].
     pub fn tick_with(
         &mut self,
-        sense: impl FnOnce(u64, &mut [SensorFrame]),
+        mut sense: impl FnMut(u64, usize, &mut [SensorFrame]),
     ) -> Result<TickOutcome, RemoteError> {
         let tick = self.tick + 1;
         self.tick = tick;
@@ -380,7 +382,7 @@ impl RemoteHosts {
             *frame = SensorFrame::empty(i as u32);
             frame.tick = tick;
         }
-        sense(tick, &mut self.frames);
+        sense(tick, 0, &mut self.frames);
         for (i, frame) in self.frames.iter_mut().enumerate() {
             frame.tick = tick;
             frame.robot = i as u32;
@@ -1048,7 +1050,7 @@ mod tests {
         world
             .wait_for_hosts(Duration::from_secs(30))
             .expect("both hosts join");
-        let outcome = world.tick_with(|_, _| {}).expect("a tick");
+        let outcome = world.tick_with(|_, _, _| {}).expect("a tick");
         assert_eq!((outcome.answered, outcome.missing, outcome.dead), (2, 1, 0));
         assert_eq!(world.command(0).map(|c| c.wheels), Some([1.0, 2.0]));
         assert_eq!(
@@ -1068,7 +1070,7 @@ mod tests {
         world
             .wait_for_hosts(Duration::from_secs(30))
             .expect("the host joins");
-        world.tick_with(|_, _| {}).expect("a tick");
+        world.tick_with(|_, _, _| {}).expect("a tick");
         assert_eq!(world.order(1, OrderAction::Kill).ok(), Some(false));
         assert!(
             world.agent_present(1),
@@ -1079,7 +1081,7 @@ mod tests {
             Some(false),
             "a robot of no host"
         );
-        let outcome = world.tick_with(|_, _| {}).expect("the next tick");
+        let outcome = world.tick_with(|_, _, _| {}).expect("the next tick");
         assert_eq!(outcome.answered, 2, "ticks go on as before");
     }
 
@@ -1092,7 +1094,7 @@ mod tests {
             .wait_for_hosts(Duration::from_secs(30))
             .expect("the host joins");
         for tick in 1..=2 {
-            let outcome = world.tick_with(|_, _| {}).expect("a tick");
+            let outcome = world.tick_with(|_, _, _| {}).expect("a tick");
             assert_eq!((outcome.tick, outcome.missing), (tick, 1));
         }
         assert!(world.dropped().rejected >= 2, "{:?}", world.dropped());
@@ -1107,13 +1109,13 @@ mod tests {
         world
             .wait_for_hosts(Duration::from_secs(30))
             .expect("both hosts join");
-        let first = world.tick_with(|_, _| {}).expect("a tick");
+        let first = world.tick_with(|_, _, _| {}).expect("a tick");
         assert_eq!(first.answered, 3);
         drop(goes);
         // The loss is decided within a tick or two (the session's end is seen in milliseconds); no tick blocks.
         let mut lost_at = None;
         for _ in 0..50 {
-            let outcome = world.tick_with(|_, _| {}).expect("a tick");
+            let outcome = world.tick_with(|_, _, _| {}).expect("a tick");
             if outcome.dead == 2 {
                 lost_at = Some(outcome.tick);
                 break;

@@ -179,7 +179,8 @@ impl AgentLink {
             }
             let open = self.sync.tick();
             if open > self.last_tick {
-                // The world writes every frame before it opens the tick, so an open tick's frame is in place.
+                // The world opens the tick before it writes the frames: until this robot's chain starts, the
+                // frame is still the last tick's, and the chain's start changes the relay word.
                 let frame = *self.ports.frame_entry.get();
                 if frame.tick == open {
                     self.last_tick = open;

@@ -32,7 +32,7 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 4;
+const LAYOUT_VERSION: u32 = 5;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -54,7 +54,8 @@ struct Header {
     world_pid: AtomicU32,
     /// Robots per relay chain: chain `c` is robots `c * relay_len ..` up to the next chain's first robot.
     relay_len: AtomicU32,
-    /// Current tick (full width), written after the tick's frames and before any relay.
+    /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
+    /// once its first robot's `chain_open` carries the tick.
     tick: AtomicU64,
     /// Tick tag and answer count; the world sleeps on it.
     acks: LineWord,
@@ -83,6 +84,9 @@ struct RobotSlot {
     /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
     /// death (a board's single writer slot stays taken by a dead writer, so a replacement gets a fresh board).
     board: AtomicU32,
+    /// In the first robot of a chain only: the last tick whose frames of the chain are in place and whose
+    /// relay has started. A relay into the chain before that would wake an agent that finds no frame.
+    chain_open: AtomicU64,
 }
 
 /// A mapping of a run's sync block.
@@ -265,7 +269,8 @@ impl SyncBlock {
     }
 
     /// Opens tick `tick` for answers: resets the count, then accounts for every robot with a death notice.
-    /// The tick's frames must be in place: from here on an agent may read its frame for `tick`.
+    /// No agent runs before its chain starts ([`SyncBlock::start_chain`]); an agent woken earlier finds its
+    /// frame still at the last tick and sleeps again.
     pub(crate) fn open_tick(&self, tick: u64) {
         let header = self.header();
         header
@@ -281,11 +286,26 @@ impl SyncBlock {
         }
     }
 
-    /// Starts the relays of `tick`: wakes the first robot of every chain.
-    pub(crate) fn start_relays(&self, tick: u64) {
-        for first in (0..self.capacity).step_by(self.relay_len as usize) {
-            self.relay_from(first, tick);
-        }
+    /// The chains, each as the range of its robots.
+    pub(crate) fn chains(&self) -> impl Iterator<Item = std::ops::Range<u32>> + use<> {
+        let (capacity, len) = (self.capacity, self.relay_len);
+        (0..capacity)
+            .step_by(len as usize)
+            .map(move |first| first..(first + len).min(capacity))
+    }
+
+    /// Starts the relay of `tick` in the chain whose first robot is `first`: the chain's frames are in place.
+    pub(crate) fn start_chain(&self, first: u32, tick: u64) {
+        // SeqCst pairs with `mark_dead`: either the relay below sees the death flag and steps over the robot,
+        // or the death notice sees the chain started and hands the tick on itself.
+        self.slot(first).chain_open.store(tick, Ordering::SeqCst);
+        self.relay_from(first, tick);
+    }
+
+    /// Whether the chain of `robot` has started `tick`.
+    fn chain_started(&self, robot: u32, tick: u64) -> bool {
+        let first = robot - robot % self.relay_len;
+        self.slot(first).chain_open.load(Ordering::SeqCst) == tick
     }
 
     /// Hands `tick` on from `robot` to the next robot of its chain, if any; called by the agent that answered
@@ -434,8 +454,9 @@ impl SyncBlock {
         futex::wake(&slot.owner, i32::MAX);
         let tick = self.header().tick.load(Ordering::SeqCst);
         self.claim(robot, tick);
-        if tick > 0 {
-            // The agent may have died holding the relay: hand the tick on in its place.
+        if tick > 0 && self.chain_started(robot, tick) {
+            // The agent may have died holding the relay: hand the tick on in its place. A chain not started
+            // yet steps over the robot when it starts.
             self.pass_on(robot, tick);
         }
     }
@@ -492,7 +513,7 @@ impl SyncBlock {
     /// Whether `robot` has a connected agent and no death notice.
     pub(crate) fn has_agent(&self, robot: u32) -> bool {
         let slot = self.slot(robot);
-        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
+        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::SeqCst) == 0
     }
 
     /// Withdraws a death notice for a robot whose agent is still connected (it was frozen, or late): it owns
@@ -659,4 +680,71 @@ impl Drop for SyncBlock {
 /// The tick tag stored in the acknowledgement word.
 fn tag(tick: u64) -> u32 {
     (tick as u32) & (u32::MAX >> COUNT_BITS)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+    use std::time::{Duration, Instant};
+
+    use super::{JoinClaim, SyncBlock};
+
+    /// A sync block in shared memory whose file is removed when the test ends, passed or not.
+    struct TestBlock {
+        block: SyncBlock,
+        path: PathBuf,
+    }
+
+    impl TestBlock {
+        /// `robots` robots in chains of `relay_len`, every robot with a joined agent.
+        fn joined(name: &str, robots: u32, relay_len: u32) -> TestBlock {
+            let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-{name}", std::process::id()));
+            let block = SyncBlock::create(&path, robots, relay_len).expect("create the block");
+            for robot in 0..robots {
+                let deadline = Instant::now() + Duration::from_secs(1);
+                assert!(matches!(
+                    block.claim_robot(robot, deadline),
+                    JoinClaim::Claimed
+                ));
+                block.announce_ready(robot);
+            }
+            TestBlock { block, path }
+        }
+    }
+
+    impl Drop for TestBlock {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+
+    #[test]
+    fn a_death_notice_hands_the_tick_on_only_in_a_chain_that_has_started() {
+        let test = TestBlock::joined("death-notice-relay", 8, 4);
+        let block = &test.block;
+        block.open_tick(1);
+        block.start_chain(0, 1);
+        assert_eq!(block.relay_word(0), 1);
+
+        // Chain 0 has started: the notice hands the tick on from robot 1 to robot 2.
+        block.mark_dead(1);
+        assert_eq!(block.relay_word(2), 1);
+
+        // Chain 1 has not: robot 6's frame is not in place, so nothing may wake it for tick 1 yet.
+        block.mark_dead(5);
+        assert_eq!(block.relay_word(6), 0);
+
+        block.start_chain(4, 1);
+        assert_eq!((block.relay_word(4), block.relay_word(6)), (1, 0));
+        // Robot 4's agent answers and relays; the relay steps over dead robot 5 to robot 6, not further.
+        block.pass_on(4, 1);
+        assert_eq!(
+            (
+                block.relay_word(5),
+                block.relay_word(6),
+                block.relay_word(7)
+            ),
+            (1, 1, 0)
+        );
+    }
 }

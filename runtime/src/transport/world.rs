@@ -319,34 +319,40 @@ impl WorldLink {
         robot < self.config.robots && self.deaths.sync.revive(robot)
     }
 
-    /// Runs one tick: `sense` fills every robot's frame (pre-set to [`SensorFrame::empty`] with this tick;
-    /// `tick` and `robot` are enforced afterwards), the frames go out, and the call returns when every robot
-    /// answered, is dead, or the deadline passed. Read the commands with [`WorldLink::command`].
+    /// Runs one tick, chain by chain: `sense(tick, first, frames)` fills the frames of the robots `first..`
+    /// (pre-set to [`SensorFrame::empty`] with this tick; `tick` and `robot` are enforced afterwards), those
+    /// frames go out and that chain's agents start while the next chain is sensed. The call returns when every
+    /// robot answered, is dead, or the deadline passed. Read the commands with [`WorldLink::command`].
+    ///
+    /// Sensing chain by chain overlaps the world's sensing with the first chains' agents (on a second core);
+    /// `sense` must therefore fill a robot's frame from the world's state alone, never from another frame.
     pub fn tick_with(
         &mut self,
-        sense: impl FnOnce(u64, &mut [SensorFrame]),
+        mut sense: impl FnMut(u64, usize, &mut [SensorFrame]),
     ) -> Result<TickOutcome, TransportError> {
         let tick = self.tick + 1;
-        for (i, frame) in self.frames.iter_mut().enumerate() {
-            *frame = SensorFrame::empty(i as u32);
-            frame.tick = tick;
-        }
-        sense(tick, &mut self.frames);
-        for ((i, frame), entry) in self
-            .frames
-            .iter_mut()
-            .enumerate()
-            .zip(&self.boards.frame_entries)
-        {
-            frame.tick = tick;
-            frame.robot = i as u32;
-            entry.update_with_copy(*frame);
-        }
-
         let sync = &self.deaths.sync;
         sync.open_tick(tick);
         self.tick = tick;
-        sync.start_relays(tick);
+        for chain in sync.chains() {
+            let robots = chain.start as usize..chain.end as usize;
+            let frames = &mut self.frames[robots.clone()];
+            for (robot, frame) in robots.clone().zip(frames.iter_mut()) {
+                *frame = SensorFrame::empty(robot as u32);
+                frame.tick = tick;
+            }
+            sense(tick, robots.start, frames);
+            for ((robot, frame), entry) in robots
+                .clone()
+                .zip(frames.iter_mut())
+                .zip(&self.boards.frame_entries[robots])
+            {
+                frame.tick = tick;
+                frame.robot = robot as u32;
+                entry.update_with_copy(*frame);
+            }
+            sync.start_chain(chain.start, tick);
+        }
         let deadline = Instant::now() + self.config.tick_deadline;
         if !sync.wait_answers(tick, self.config.spin, self.config.relay_stall, deadline) {
             tracing::debug!(tick, "tick deadline passed with answers missing");

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use swarm_runtime::launcher::EVENT_TABLES_FILE;
 
+use super::csv_line::CsvLine;
 use crate::arena::Arena;
 use crate::error::WorldError;
 
@@ -104,15 +105,17 @@ impl EventsWriter {
             }
         };
         let robot_entry = self.robots.get(robot as usize);
+        let start = |out| CsvLine::new(out).int(tick)?.int(robot);
         match (*row, robot_entry) {
             (EventRow::Fault { name, .. }, _) => {
                 let id = robot_entry.map_or("", |(id, _)| id.as_str());
-                writeln!(self.out, "{tick},{robot},{id},{name}")
+                start(&mut self.out)?.text(id)?.text(name)?.end()
             }
             (EventRow::Fired { event, .. }, Some((id, names))) => {
+                let line = start(&mut self.out)?.text(id)?;
                 match names.get(usize::from(event)) {
-                    Some(name) => writeln!(self.out, "{tick},{robot},{id},{name}"),
-                    None => writeln!(self.out, "{tick},{robot},{id},#{event}"),
+                    Some(name) => line.text(name)?.end(),
+                    None => line.prefixed_int("#", event)?.end(),
                 }
             }
             // Not a robot of this run: nothing to name it by.

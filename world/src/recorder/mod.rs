@@ -5,6 +5,7 @@
 //! batch per tick ([`background`], [`files`]). Recording reads the world and never changes it.
 
 pub mod background;
+mod csv_line;
 pub mod events;
 pub mod files;
 pub mod snapshot;

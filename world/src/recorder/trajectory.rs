@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use swarm_runtime::messages::Rgb;
 
+use super::csv_line::CsvLine;
 use crate::arena::Arena;
 use crate::error::WorldError;
 
@@ -93,17 +94,16 @@ impl TrajectoryWriter {
             .names
             .get(row.robot as usize)
             .map_or("", String::as_str);
-        writeln!(
-            self.out,
-            "{},{name},{},{},{},{},{},{},{}",
-            row.tick,
-            row.x,
-            row.y,
-            row.heading,
-            row.led.r,
-            row.led.g,
-            row.led.b,
-            u8::from(row.alive)
-        )
+        CsvLine::new(&mut self.out)
+            .int(row.tick)?
+            .text(name)?
+            .float(row.x)?
+            .float(row.y)?
+            .float(row.heading)?
+            .int(row.led.r)?
+            .int(row.led.g)?
+            .int(row.led.b)?
+            .int(u8::from(row.alive))?
+            .end()
     }
 }

@@ -151,7 +151,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             &commands,
         )?;
         let tick_started = Instant::now();
-        let outcome = link.tick_with(|_, frames| world.sense(frames))?;
+        let outcome = link.tick_with(|_, first, frames| world.sense_robots(first, frames))?;
         for robot in 0..robots {
             match link
                 .command(robot as u32)

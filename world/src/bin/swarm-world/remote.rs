@@ -98,7 +98,7 @@ impl Link {
     /// Runs one tick; see `WorldLink::tick_with`.
     pub fn tick_with(
         &mut self,
-        sense: impl FnOnce(u64, &mut [SensorFrame]),
+        sense: impl FnMut(u64, usize, &mut [SensorFrame]),
     ) -> anyhow::Result<TickOutcome> {
         Ok(match self {
             Link::Local(link) => link.tick_with(sense)?,

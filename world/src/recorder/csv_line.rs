@@ -1,0 +1,104 @@
+//! Writing a CSV line field by field, straight into the file's buffer.
+//!
+//! The recorder's thread writes one trajectory row per robot per tick; with `write!` the `core::fmt` machinery
+//! (shortest float digits by Grisu, padding, one adapter call per piece) took about 1.3 µs per row at N = 1,000,
+//! more than a quarter of the world process's CPU. `itoa` and `ryu` format into stack buffers, and the pieces go
+//! into the `BufWriter` as byte slices. Floats are written in `ryu`'s shortest round-trip form (`1.0`, `0.25`,
+//! `1.5E-7`), which every CSV reader parses.
+
+use std::io::{BufWriter, Write};
+
+/// Writes one line's fields, separated by commas, into `out`; [`CsvLine::end`] ends the line.
+pub struct CsvLine<'a, W: Write> {
+    out: &'a mut BufWriter<W>,
+    first: bool,
+}
+
+impl<'a, W: Write> CsvLine<'a, W> {
+    /// Starts a line.
+    pub fn new(out: &'a mut BufWriter<W>) -> Self {
+        CsvLine { out, first: true }
+    }
+
+    fn separate(&mut self) -> std::io::Result<()> {
+        if !std::mem::take(&mut self.first) {
+            self.out.write_all(b",")?;
+        }
+        Ok(())
+    }
+
+    /// An integer field.
+    pub fn int(mut self, value: impl itoa::Integer) -> std::io::Result<Self> {
+        self.separate()?;
+        self.out
+            .write_all(itoa::Buffer::new().format(value).as_bytes())?;
+        Ok(self)
+    }
+
+    /// A float field, shortest round-trip digits.
+    pub fn float(mut self, value: f32) -> std::io::Result<Self> {
+        self.separate()?;
+        self.out
+            .write_all(ryu::Buffer::new().format(value).as_bytes())?;
+        Ok(self)
+    }
+
+    /// A text field, as is (the caller's text holds no comma, quote or line break).
+    pub fn text(mut self, value: &str) -> std::io::Result<Self> {
+        self.separate()?;
+        self.out.write_all(value.as_bytes())?;
+        Ok(self)
+    }
+
+    /// A text field made of `prefix` and an integer (`#7`).
+    pub fn prefixed_int(
+        mut self,
+        prefix: &str,
+        value: impl itoa::Integer,
+    ) -> std::io::Result<Self> {
+        self.separate()?;
+        self.out.write_all(prefix.as_bytes())?;
+        self.out
+            .write_all(itoa::Buffer::new().format(value).as_bytes())?;
+        Ok(self)
+    }
+
+    /// Ends the line.
+    pub fn end(self) -> std::io::Result<()> {
+        self.out.write_all(b"\n")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::BufWriter;
+
+    use super::CsvLine;
+
+    fn line(write: impl FnOnce(CsvLine<'_, Vec<u8>>) -> std::io::Result<()>) -> String {
+        let mut out = BufWriter::new(Vec::new());
+        write(CsvLine::new(&mut out)).expect("writes");
+        String::from_utf8(out.into_inner().expect("flushes")).expect("utf-8")
+    }
+
+    #[test]
+    fn fields_are_comma_separated_and_floats_read_back_exactly() {
+        let values = [0.0f32, -1.25, 1.0 / 3.0, 1.5e-7, 2.0e9, f32::MIN_POSITIVE];
+        let text = line(|l| {
+            let mut l = l.int(42u64)?.text("ep3")?;
+            for v in values {
+                l = l.float(v)?;
+            }
+            l.prefixed_int("#", 7u8)?.int(255u8)?.end()
+        });
+        let fields: Vec<&str> = text.trim_end_matches('\n').split(',').collect();
+        assert_eq!(&fields[..2], ["42", "ep3"]);
+        let floats: Vec<f32> = fields[2..8]
+            .iter()
+            .map(|f| f.parse().expect("a float"))
+            .collect();
+        assert_eq!(floats, values);
+        assert_eq!(&fields[8..], ["#7", "255"]);
+        assert!(text.ends_with('\n') && text.matches('\n').count() == 1);
+    }
+}
