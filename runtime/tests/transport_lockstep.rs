@@ -173,16 +173,14 @@ fn frozen_agent_misses_the_deadline_while_the_others_keep_ticking() {
     }
 }
 
-#[test]
-fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after_it() {
-    let mut run = Run::new();
-    // Two chains of four: 0-1-2-3 and 4-5-6-7. Robot 1 stops answering, so no relay reaches 2 and 3; the
-    // world's rescue must wake them long before the deadline.
-    let mut link_config = config(8, 5_000);
+/// A world of 8 robots woken in two chains of four (0-1-2-3 and 4-5-6-7) whose agent for `frozen` stops
+/// answering from tick 2, after a tick 1 that every agent answered.
+fn two_chains_of_four_after_tick_1(run: &mut Run, deadline_ms: u64, frozen: u32) -> WorldLink {
+    let mut link_config = config(8, deadline_ms);
     link_config.relays = 2;
     let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
     for robot in 0..8 {
-        let extra: &[&str] = if robot == 1 {
+        let extra: &[&str] = if robot == frozen {
             &["--freeze-at", "2"]
         } else {
             &[]
@@ -191,6 +189,15 @@ fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after
     }
     world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
     assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    world
+}
+
+#[test]
+fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after_it() {
+    let mut run = Run::new();
+    // Robot 1 stops answering, so no relay reaches 2 and 3; the world's rescue must wake them long before the
+    // deadline.
+    let mut world = two_chains_of_four_after_tick_1(&mut run, 5_000, 1);
     for tick in 2..=4 {
         let outcome = world.tick_with(sense).expect("tick");
         assert_eq!((outcome.answered, outcome.missing), (7, 1), "tick {tick}");
@@ -208,23 +215,11 @@ fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after
 #[test]
 fn death_notice_for_a_chain_not_yet_started_wakes_nobody_before_their_frames_are_in_place() {
     let mut run = Run::new();
-    // Two chains of four: 0-1-2-3 and 4-5-6-7. Robot 5's agent stops answering at tick 2 and its death notice
-    // arrives while the world is still sensing chain 0: chain 1 must step over robot 5 when it starts, and
-    // robots 6 and 7 answer with their own frames. (The sync block's unit test checks that the notice wakes
-    // nobody in chain 1 early, which this race seldom shows.)
-    let mut link_config = config(8, 20_000);
-    link_config.relays = 2;
-    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
-    for robot in 0..8 {
-        let extra: &[&str] = if robot == 5 {
-            &["--freeze-at", "2"]
-        } else {
-            &[]
-        };
-        run.spawn(robot, extra);
-    }
-    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
-    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    // Robot 5's agent stops answering at tick 2 and its death notice arrives while the world is still sensing
+    // chain 0: chain 1 must step over robot 5 when it starts, and robots 6 and 7 answer with their own frames.
+    // (The sync block's unit test checks that the notice wakes nobody in chain 1 early, which this race seldom
+    // shows.)
+    let mut world = two_chains_of_four_after_tick_1(&mut run, 20_000, 5);
     let notices = world.death_notices();
     let outcome = world
         .tick_with(|tick, first, frames| {
