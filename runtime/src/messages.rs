@@ -147,6 +147,26 @@ impl SensorFrame {
         }
     }
 
+    /// Fills `frames`, the frames of robots `first..`, for `tick` with `sense(tick, first, frames)`: each
+    /// starts as [`SensorFrame::empty`] with the tick, and its `tick` and `robot` are enforced afterwards, so
+    /// a sense function can neither misdate a frame nor move it to another robot.
+    pub(crate) fn sense_into(
+        tick: u64,
+        first: usize,
+        frames: &mut [SensorFrame],
+        sense: &mut impl FnMut(u64, usize, &mut [SensorFrame]),
+    ) {
+        for (robot, frame) in (first as u32..).zip(frames.iter_mut()) {
+            *frame = SensorFrame::empty(robot);
+            frame.tick = tick;
+        }
+        sense(tick, first, frames);
+        for (robot, frame) in (first as u32..).zip(frames.iter_mut()) {
+            frame.tick = tick;
+            frame.robot = robot;
+        }
+    }
+
     /// The valid camera blobs.
     pub fn camera_blobs(&self) -> &[CameraBlob] {
         &self.camera[..usize::from(self.camera_len).min(MAX_CAMERA_BLOBS)]

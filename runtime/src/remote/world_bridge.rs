@@ -378,15 +378,7 @@ impl RemoteHosts {
             self.handle(event, false)?;
         }
         self.retry_assignments()?;
-        for (i, frame) in self.frames.iter_mut().enumerate() {
-            *frame = SensorFrame::empty(i as u32);
-            frame.tick = tick;
-        }
-        sense(tick, 0, &mut self.frames);
-        for (i, frame) in self.frames.iter_mut().enumerate() {
-            frame.tick = tick;
-            frame.robot = i as u32;
-        }
+        SensorFrame::sense_into(tick, 0, &mut self.frames, &mut sense);
         for status in &mut self.status {
             *status = CommandStatus::Missing;
         }

@@ -337,18 +337,8 @@ impl WorldLink {
         for chain in sync.chains() {
             let robots = chain.start as usize..chain.end as usize;
             let frames = &mut self.frames[robots.clone()];
-            for (robot, frame) in robots.clone().zip(frames.iter_mut()) {
-                *frame = SensorFrame::empty(robot as u32);
-                frame.tick = tick;
-            }
-            sense(tick, robots.start, frames);
-            for ((robot, frame), entry) in robots
-                .clone()
-                .zip(frames.iter_mut())
-                .zip(&self.boards.frame_entries[robots])
-            {
-                frame.tick = tick;
-                frame.robot = robot as u32;
+            SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
+            for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
                 entry.update_with_copy(*frame);
             }
             sync.start_chain(chain.start, tick);
