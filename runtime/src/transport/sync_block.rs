@@ -510,7 +510,8 @@ impl SyncBlock {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
     }
 
-    /// Whether `robot` has a connected agent and no death notice.
+    /// Whether `robot` has a connected agent and no death notice. The death flag is read sequentially
+    /// consistent for [`SyncBlock::start_chain`]'s pairing with `mark_dead`.
     pub(crate) fn has_agent(&self, robot: u32) -> bool {
         let slot = self.slot(robot);
         slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::SeqCst) == 0
