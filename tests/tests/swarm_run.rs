@@ -69,6 +69,10 @@ fn forty_robot_run_completes_with_one_process_per_robot() {
         !agents.contains(&u64::from(outcome.pid)),
         "no robot ran inside the launcher"
     );
+    for cpu in ["cpu_agents_us_per_robot_step", "cpu_world_us_per_tick"] {
+        let used = summary[cpu].as_f64().unwrap_or(0.0);
+        assert!(used > 0.0, "{cpu} is measured: {}", summary[cpu]);
+    }
     let trajectory =
         std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
     assert_eq!(

@@ -17,23 +17,31 @@ pub struct CpuMark(Duration);
 impl CpuMark {
     /// Marks the CPU time used so far by this process and `pids`.
     pub fn take(pids: impl IntoIterator<Item = u32>) -> CpuMark {
+        Self::take_of(std::iter::once(std::process::id()).chain(pids))
+    }
+
+    /// Marks the CPU time used so far by `pids` alone.
+    pub fn take_of(pids: impl IntoIterator<Item = u32>) -> CpuMark {
         CpuMark(total_cpu(pids))
     }
 
-    /// The CPU time this process and `pids` used since the mark, divided by `robot_steps`.
+    /// The CPU time this process and `pids` used since the mark (taken with [`CpuMark::take`]), divided by
+    /// `robot_steps`.
     pub fn per_step(&self, pids: impl IntoIterator<Item = u32>, robot_steps: f64) -> Duration {
+        self.per_step_of(std::iter::once(std::process::id()).chain(pids), robot_steps)
+    }
+
+    /// The CPU time `pids` used since the mark (taken with [`CpuMark::take_of`]), divided by `steps`.
+    pub fn per_step_of(&self, pids: impl IntoIterator<Item = u32>, steps: f64) -> Duration {
         total_cpu(pids)
             .saturating_sub(self.0)
-            .div_f64(robot_steps.max(1.0))
+            .div_f64(steps.max(1.0))
     }
 }
 
-/// The summed CPU time of this process and `pids` (processes that are gone count nothing).
+/// The summed CPU time of `pids` (processes that are gone count nothing).
 fn total_cpu(pids: impl IntoIterator<Item = u32>) -> Duration {
-    std::iter::once(std::process::id())
-        .chain(pids)
-        .map(process_cpu)
-        .sum()
+    pids.into_iter().map(process_cpu).sum()
 }
 
 /// CPU time of every live thread of process `pid` so far; zero when it is gone.

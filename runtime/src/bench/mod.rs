@@ -3,9 +3,10 @@
 //! Whole system: ARGoS' obstacle-avoidance density (`density_N<N>.argos`: 50 e-pucks per 16 m², N/10 boxes and
 //! N/10 cylinders) with one agent process per robot, through the same launcher as `swarm run`, repeated; per N the
 //! medians of robot-steps per second, p50/p99 tick time (the world's own figures from summary.json), time to the
-//! first tick, and each agent's peak RSS. Bare: the lockstep round trip with no world work and no player
-//! ([`bare`]), next to the same-hour floor of a minimal futex-broadcast lockstep ([`floor`]). Real time: one
-//! paced run (e.g. 2,000 agents at 10 ticks/s) and whether every tick kept its slot.
+//! first tick, each agent's peak RSS, and the CPU time the agents use per robot-step and the world per tick.
+//! Bare: the lockstep round trip with no world work and no player ([`bare`]), next to the same-hour floor of a
+//! minimal futex-broadcast lockstep ([`floor`]). Real time: one paced run (e.g. 2,000 agents at 10 ticks/s) and
+//! whether every tick kept its slot.
 
 pub mod bare;
 pub mod cpu;
@@ -71,6 +72,11 @@ pub struct SystemFigures {
     pub agent_peak_rss_kib_median: f64,
     /// Largest agent peak RSS, in KiB.
     pub agent_peak_rss_kib_max: f64,
+    /// Median over the runs of the agents' CPU time per robot-step while ticking, in microseconds (from the
+    /// scheduler's accounts; see `swarm-world`'s summary).
+    pub cpu_agents_us_per_robot_step: f64,
+    /// Median over the runs of the world process's CPU time per tick (every thread), in microseconds.
+    pub cpu_world_us_per_tick: f64,
 }
 
 /// Bare lockstep figures for one robot count.
@@ -303,6 +309,8 @@ fn system(
     let mut p99s = Vec::new();
     let mut first_ticks = Vec::new();
     let mut rss = Vec::new();
+    let mut agents_cpu = Vec::new();
+    let mut world_cpu = Vec::new();
     for repetition in 0..options.repeat.max(1) {
         let out = options.out.join(format!("system_N{robots}_{repetition}"));
         let summary_path = out.join("summary.json");
@@ -315,6 +323,12 @@ fn system(
             "time_to_first_tick_seconds",
             &summary_path,
         )?);
+        agents_cpu.push(figure(
+            &summary,
+            "cpu_agents_us_per_robot_step",
+            &summary_path,
+        )?);
+        world_cpu.push(figure(&summary, "cpu_world_us_per_tick", &summary_path)?);
         rss.extend(peaks);
     }
     Ok(SystemFigures {
@@ -328,6 +342,8 @@ fn system(
         first_tick_seconds: median(&first_ticks).unwrap_or(0.0),
         agent_peak_rss_kib_median: median(&rss).unwrap_or(0.0),
         agent_peak_rss_kib_max: rss.iter().copied().fold(0.0, f64::max),
+        cpu_agents_us_per_robot_step: median(&agents_cpu).unwrap_or(0.0),
+        cpu_world_us_per_tick: median(&world_cpu).unwrap_or(0.0),
     })
 }
 
@@ -356,12 +372,12 @@ pub fn markdown(report: &BenchReport) -> String {
     let mut text = String::new();
     if !report.system.is_empty() {
         text.push_str(
-            "| N | runs x ticks | robot-steps/s (median) | tick p50 | tick p99 | first tick | agent peak RSS (median / max) |\n\
-             |---|---|---|---|---|---|---|\n",
+            "| N | runs x ticks | robot-steps/s (median) | tick p50 | tick p99 | first tick | agent peak RSS (median / max) \
+             | agent CPU per robot-step | world CPU per tick |\n|---|---|---|---|---|---|---|---|---|\n",
         );
         for f in &report.system {
             text.push_str(&format!(
-                "| {} | {} x {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.1} / {:.1} MiB |\n",
+                "| {} | {} x {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.1} / {:.1} MiB | {:.1} µs | {:.0} µs |\n",
                 f.robots,
                 f.runs,
                 f.ticks,
@@ -371,6 +387,8 @@ pub fn markdown(report: &BenchReport) -> String {
                 f.first_tick_seconds,
                 f.agent_peak_rss_kib_median / 1024.0,
                 f.agent_peak_rss_kib_max / 1024.0,
+                f.cpu_agents_us_per_robot_step,
+                f.cpu_world_us_per_tick,
             ));
         }
     }

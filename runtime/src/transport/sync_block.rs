@@ -517,6 +517,12 @@ impl SyncBlock {
         slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::SeqCst) == 0
     }
 
+    /// The process id of `robot`'s agent, if one owns the robot.
+    pub(crate) fn agent_pid(&self, robot: u32) -> Option<u32> {
+        let slot = self.slot(robot);
+        (slot.owner.load(Ordering::Acquire) == 1).then(|| slot.owner_pid.load(Ordering::Acquire))
+    }
+
     /// Withdraws a death notice for a robot whose agent is still connected (it was frozen, or late): it owns
     /// the robot again and ticks wait for it again. `false` if another agent claimed the robot meanwhile.
     pub(crate) fn revive(&self, robot: u32) -> bool {

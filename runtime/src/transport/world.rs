@@ -312,6 +312,13 @@ impl WorldLink {
         robot < self.config.robots && self.deaths.sync.has_agent(robot)
     }
 
+    /// The process ids of the robots' agents (robots without one are left out).
+    pub fn agent_pids(&self) -> Vec<u32> {
+        (0..self.config.robots)
+            .filter_map(|robot| self.deaths.sync.agent_pid(robot))
+            .collect()
+    }
+
     /// Withdraws the death notice of `robot`, whose agent is still connected (thawed, or answering again after
     /// missing deadlines): from the next tick on, ticks wait for it again. `false` when the robot is out of
     /// range or another agent has claimed it meanwhile.

@@ -13,6 +13,7 @@
 mod faults;
 mod pacing;
 mod remote;
+mod ticking_cpu;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -35,6 +36,7 @@ use swarm_world::recorder::Recorder;
 use faults::FaultDriver;
 use pacing::Pacer;
 use remote::Link;
+use ticking_cpu::TickingCpu;
 
 /// Minimum interval between two progress reports to the launcher.
 const REPORT_INTERVAL: Duration = Duration::from_millis(50);
@@ -131,6 +133,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
     faults.wait_for_agents(&mut link, &mut world, &mut recorder, &commands)?;
+    let cpu = TickingCpu::start(&link);
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -182,6 +185,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         pacer.end_of_tick(outcome.tick);
     }
     let ticking = started.elapsed().as_secs_f64();
+    let cpu = cpu.map(|cpu| cpu.summary(&link, robot_steps));
     let ticks = link.tick();
     let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
@@ -196,6 +200,9 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         object.insert("alive_final".into(), faults.alive_count().into());
         if let Some(hosts) = link.summary() {
             object.insert("hosts".into(), hosts);
+        }
+        if let Some(serde_json::Value::Object(cpu)) = cpu {
+            object.extend(cpu);
         }
     }
     recorder.finish(&world, extra)?;
