@@ -116,6 +116,7 @@ pub fn bind<P: Profile>(state: P, events: &[CompiledEvent]) -> Result<Bound<P>, 
 }
 
 impl<P: Profile> EventCallbacks for Bound<P> {
+    #[unsafe(link_section = "swarm_hot")]
     fn check(&mut self, event: u8, frame: &SensorFrame) -> bool {
         match self.table.get(usize::from(event)) {
             Some(Procedure::Check(check)) => check(&self.state, frame),
@@ -129,6 +130,7 @@ impl<P: Profile> EventCallbacks for Bound<P> {
         }
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn act(&mut self, event: u8, frame: &SensorFrame, command: &mut ActuatorCommand) {
         match self.table.get(usize::from(event)) {
             Some(Procedure::Act(act)) => act(&mut self.state, frame, command),

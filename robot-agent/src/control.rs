@@ -69,6 +69,7 @@ impl Control {
 
     /// One control step: the player's step with the bound callbacks, or the native controller's step. `command`
     /// carries the actuator state over from the previous tick; allocates nothing.
+    #[unsafe(link_section = "swarm_hot")]
     pub fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {
         match self {
             Control::Supervised { player, callbacks } => player.step(frame, callbacks, command),

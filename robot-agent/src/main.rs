@@ -197,11 +197,24 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
         slot,
         "joined the run"
     );
+    tick_loop(&mut link, control, &mut resumer, args.robot)
+}
+
+/// The agent's tick loop: step the controller on each tick's frame and answer, until the world ends the run or
+/// the agent is asked to stop.
+#[unsafe(link_section = "swarm_hot")]
+#[inline(never)]
+fn tick_loop(
+    link: &mut AgentLink,
+    control: &mut Control,
+    resumer: &mut Resumer,
+    robot: u32,
+) -> Result<()> {
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
-    let mut command = ActuatorCommand::idle(args.robot, 0);
+    let mut command = ActuatorCommand::idle(robot, 0);
     while let Some(tick) = link.next_tick().context("waiting for a tick")? {
         if STOP_REQUESTED.load(Ordering::Relaxed) {
-            info!(robot = args.robot, "asked to stop: leaving the run");
+            info!(robot, "asked to stop: leaving the run");
             return Ok(());
         }
         if resumer.before_step(control, tick.frame())? {
@@ -209,9 +222,9 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
         } else {
             command.events_len = 0;
         }
-        link.answer(tick, &command).context("answering a tick")?;
+        tick.answer(&mut command);
     }
-    info!(robot = args.robot, "the world ended the run");
+    info!(robot, "the world ended the run");
     Ok(())
 }
 

@@ -35,6 +35,7 @@ impl Resumer {
     }
 
     /// Whether `control` should step on `frame`; restores its player first when the frame follows a gap.
+    #[unsafe(link_section = "swarm_hot")]
     pub fn before_step(
         &mut self,
         control: &mut Control,

@@ -235,24 +235,28 @@ impl Player {
         self.mismatches
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn owners_of(&self, event: u8) -> &[u16] {
         let e = usize::from(event);
         &self.owners[self.owner_offsets[e] as usize..self.owner_offsets[e + 1] as usize]
     }
 
     /// The transition of supervisor `sup` on `event` from its current state.
+    #[unsafe(link_section = "swarm_hot")]
     fn transition(&self, sup: usize, event: u8) -> Option<&CompiledTransition> {
         let state = self.state_base[sup] as usize + usize::from(self.current[sup]);
         let range = self.state_offsets[state] as usize..self.state_offsets[state + 1] as usize;
         self.transitions[range].iter().find(|t| t.event == event)
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn enabled_in_every_owner(&self, event: u8) -> bool {
         self.owners_of(event)
             .iter()
             .all(|&sup| self.transition(usize::from(sup), event).is_some())
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn last_fired(&self, sup: usize, event: u8) -> u64 {
         let slot = self.timer_slot[sup * self.events.len() + usize::from(event)];
         if slot == NO_SLOT {
@@ -263,6 +267,7 @@ impl Player {
     }
 
     /// move(i, e) of section 8.4.
+    #[unsafe(link_section = "swarm_hot")]
     fn advance(&mut self, sup: usize, event: u8) {
         let Some(target) = self.transition(sup, event).map(|t| t.target) else {
             return;
@@ -279,6 +284,7 @@ impl Player {
         }
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn fire(&mut self, event: u8, command: &mut ActuatorCommand) {
         for index in
             self.owner_offsets[usize::from(event)]..self.owner_offsets[usize::from(event) + 1]
@@ -295,6 +301,7 @@ impl Player {
 
     /// The weight of controllable `event` if it is enabled now: every owner has the transition and its lower
     /// bound is met; the product of the owners' probabilities (Q0.16 as f64, ascending supervisor order).
+    #[unsafe(link_section = "swarm_hot")]
     fn enabled_weight(&self, event: u8) -> Option<f64> {
         let owners = self.owners_of(event);
         if owners.is_empty() {
@@ -315,6 +322,7 @@ impl Player {
 
     /// One player iteration (one tick). Fills `command.events`/`events_len` with the events fired, in order,
     /// and `command.supervisors` with the snapshot after the step.
+    #[unsafe(link_section = "swarm_hot")]
     pub fn step(
         &mut self,
         frame: &SensorFrame,
@@ -360,11 +368,12 @@ impl Player {
             self.fire(chosen, command);
             callbacks.act(chosen, frame, command);
         }
-        command.supervisors = self.snapshot();
+        self.write_snapshot(&mut command.supervisors);
     }
 
     /// Roulette over the enabled events: r ~ U[0, total), the first with cumulative weight > r; uniform when
     /// every weight is 0 (section 5.2).
+    #[unsafe(link_section = "swarm_hot")]
     fn choose(&mut self, total: f64) -> Option<u8> {
         if self.enabled.is_empty() {
             return None;
@@ -398,30 +407,43 @@ impl Player {
 
     /// The supervisors' states and timers: enough to resume them exactly with [`Player::restore`].
     pub fn snapshot(&self) -> SupervisorSnapshot {
-        let mut snapshot = SupervisorSnapshot {
-            count: self.current.len() as u8,
-            ..SupervisorSnapshot::default()
-        };
-        snapshot.states[..self.current.len()].copy_from_slice(&self.current);
-        snapshot.entered[..self.entered.len()].copy_from_slice(&self.entered);
-        'all: for sup in 0..self.current.len() {
+        let mut snapshot = SupervisorSnapshot::default();
+        self.write_snapshot(&mut snapshot);
+        snapshot
+    }
+
+    /// Writes the snapshot over `snapshot` in place, touching only the entries in use (the step does so into its
+    /// command every tick). Stamps the earlier snapshot used beyond the new ones are cleared, so a snapshot only
+    /// this player ever wrote equals [`Player::snapshot`].
+    #[unsafe(link_section = "swarm_hot")]
+    fn write_snapshot(&self, snapshot: &mut SupervisorSnapshot) {
+        let count = self.current.len();
+        let stale = usize::from(snapshot.fired_len).min(MAX_FIRED_STAMPS);
+        snapshot.count = count as u8;
+        snapshot.states[..count].copy_from_slice(&self.current);
+        snapshot.entered[..count].copy_from_slice(&self.entered);
+        let mut stamps = 0;
+        'all: for sup in 0..count {
             for timer in self.timer_base[sup] as usize..self.timer_base[sup + 1] as usize {
                 let fired = self.fired[timer];
                 // Only stamps later than the state's entry affect a counter.
                 if fired > self.entered[sup] {
-                    if usize::from(snapshot.fired_len) == MAX_FIRED_STAMPS {
+                    if stamps == MAX_FIRED_STAMPS {
                         break 'all;
                     }
-                    snapshot.fired[usize::from(snapshot.fired_len)] = FiredStamp {
+                    snapshot.fired[stamps] = FiredStamp {
                         supervisor: sup as u8,
                         event: self.timer_event[timer],
                         tick: fired,
                     };
-                    snapshot.fired_len += 1;
+                    stamps += 1;
                 }
             }
         }
-        snapshot
+        if stale > stamps {
+            snapshot.fired[stamps..stale].fill(FiredStamp::default());
+        }
+        snapshot.fired_len = stamps as u8;
     }
 
     /// Resumes from `snapshot`, taken after tick `tick`: the next step is tick `tick + 1`, with the random

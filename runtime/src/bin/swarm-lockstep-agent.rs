@@ -40,17 +40,17 @@ fn main() -> Result<()> {
     if let Some(spin) = args.spin {
         link.set_spin(spin);
     }
-    while let Some(frame) = link.next_tick().context("waiting for a tick")? {
-        let tick = frame.tick();
-        if args.die_at == Some(tick) {
+    while let Some(tick) = link.next_tick().context("waiting for a tick")? {
+        let number = tick.number();
+        if args.die_at == Some(number) {
             std::process::abort();
         }
-        if args.freeze_at.is_some_and(|t| tick >= t) {
+        if args.freeze_at.is_some_and(|t| number >= t) {
             continue;
         }
-        let mut command = ActuatorCommand::idle(args.robot, tick);
-        command.wheels = frame.frame().position;
-        link.answer(frame, &command).context("answering")?;
+        let mut command = ActuatorCommand::idle(args.robot, number);
+        command.wheels = tick.frame().position;
+        tick.answer(&mut command);
     }
     Ok(())
 }

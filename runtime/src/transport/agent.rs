@@ -4,6 +4,12 @@
 //!
 //! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
 //! never answer a tick the world has not opened yet, nor the same tick twice.
+//!
+//! Every function an agent runs once per tick (here, in the sync block and futex modules, in the player and in
+//! `robot-agent`'s tick loop) is placed in the link section `swarm_hot`. With a thousand agent processes on two
+//! cores, each agent starts its tick with an empty TLB: the code it runs, scattered over the binary, cost one
+//! page walk per page; gathered in one section it spans a few adjacent pages (docs/transport.md, "Agent code
+//! locality"). The section is an ordinary executable one that the linker places after `.text`.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -26,20 +32,34 @@ const BOARD_WAIT: Duration = Duration::from_secs(30);
 /// Default number of polls of the relay word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
-/// One tick's frame of this agent's robot, loaded from the world's frame board.
-pub struct TickFrame {
-    frame: SensorFrame,
+/// A tick the world opened for this agent's robot: the robot's frame, answered at most once with
+/// [`Tick::answer`]. Dropping it leaves the tick unanswered (an agent that leaves the run, or a frozen one).
+pub struct Tick<'link> {
+    link: &'link mut AgentLink,
 }
 
-impl TickFrame {
+impl Tick<'_> {
     /// The robot's frame.
     pub fn frame(&self) -> &SensorFrame {
-        &self.frame
+        &self.link.frame
     }
 
-    /// The tick of the frame.
-    pub fn tick(&self) -> u64 {
-        self.frame.tick
+    /// The tick's number.
+    pub fn number(&self) -> u64 {
+        self.link.frame.tick
+    }
+
+    /// Sends `command` as the robot's answer to this tick, with its `tick` and `robot` fields set here, and
+    /// hands the tick on to the next robot of the chain.
+    #[unsafe(link_section = "swarm_hot")]
+    pub fn answer(self, command: &mut ActuatorCommand) {
+        let link = self.link;
+        let tick = link.frame.tick;
+        command.tick = tick;
+        command.robot = link.robot;
+        link.ports.command_entry.update_with_copy(*command);
+        link.sync.pass_on(link.robot, tick);
+        link.sync.claim(link.robot, tick);
     }
 }
 
@@ -61,6 +81,8 @@ pub struct AgentLink {
     spin: u32,
     /// The last tick handed out by [`AgentLink::next_tick`] (0: none yet).
     last_tick: u64,
+    /// The robot's frame of the last tick loaded; [`Tick::frame`] lends it out.
+    frame: SensorFrame,
     ports: Ports,
     sync: Arc<SyncBlock>,
     /// Notices the end of the world process, so that waits need no timeout (`None`: no pidfd here).
@@ -90,6 +112,7 @@ impl AgentLink {
                     robot,
                     spin: DEFAULT_AGENT_SPIN,
                     last_tick,
+                    frame: SensorFrame::empty(robot),
                     ports,
                     sync,
                     world_watch,
@@ -168,10 +191,11 @@ impl AgentLink {
         self.spin = polls;
     }
 
-    /// Waits for the next tick the world opens and returns this robot's frame; `None` when the world ended the
-    /// run, [`TransportError::WorldGone`] when the world process died without ending it. An agent that fell
-    /// behind skips straight to the newest tick.
-    pub fn next_tick(&mut self) -> Result<Option<TickFrame>, TransportError> {
+    /// Waits for the next tick the world opens and hands it out with this robot's frame; `None` when the world
+    /// ended the run, [`TransportError::WorldGone`] when the world process died without ending it. An agent that
+    /// fell behind skips straight to the newest tick.
+    #[unsafe(link_section = "swarm_hot")]
+    pub fn next_tick(&mut self) -> Result<Option<Tick<'_>>, TransportError> {
         loop {
             let seen = self.sync.relay_word(self.robot);
             if self.sync.stopped() {
@@ -181,10 +205,10 @@ impl AgentLink {
             if open > self.last_tick {
                 // The world opens the tick before it writes the frames: until this robot's chain starts, the
                 // frame is still the last tick's, and the chain's start changes the relay word.
-                let frame = *self.ports.frame_entry.get();
-                if frame.tick == open {
+                self.frame = *self.ports.frame_entry.get();
+                if self.frame.tick == open {
                     self.last_tick = open;
-                    return Ok(Some(TickFrame { frame }));
+                    return Ok(Some(Tick { link: self }));
                 }
             }
             let world_gone = self.world_watch.as_ref().map(WorldWatch::gone);
@@ -192,23 +216,6 @@ impl AgentLink {
                 .wait_relay(self.robot, seen, self.spin, world_gone)
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
-    }
-
-    /// Sends `command` as this robot's answer to `frame`'s tick (its `tick` and `robot` fields are set from the
-    /// frame).
-    pub fn answer(
-        &mut self,
-        frame: TickFrame,
-        command: &ActuatorCommand,
-    ) -> Result<(), TransportError> {
-        let tick = frame.tick();
-        let mut answer = *command;
-        answer.tick = tick;
-        answer.robot = self.robot;
-        self.ports.command_entry.update_with_copy(answer);
-        self.sync.pass_on(self.robot, tick);
-        self.sync.claim(self.robot, tick);
-        Ok(())
     }
 }
 

@@ -12,6 +12,7 @@ use std::time::Duration;
 /// Returns on a wake-up, a value change, a signal or the timeout; callers re-check their condition in a loop,
 /// so every return is a "maybe". The result tells whether the timeout expired, so that callers can act on a
 /// long silence without reading the clock on every wake-up.
+#[unsafe(link_section = "swarm_hot")]
 pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) -> Waited {
     let spec = timeout.map(|t| libc::timespec {
         tv_sec: libc::time_t::try_from(t.as_secs()).unwrap_or(libc::time_t::MAX),
@@ -54,6 +55,7 @@ pub enum Waited {
 }
 
 /// Wakes at most `count` processes blocked in [`wait`] on `word` (`i32::MAX` wakes all).
+#[unsafe(link_section = "swarm_hot")]
 pub fn wake(word: &AtomicU32, count: i32) {
     // SAFETY: `word` is a live, aligned 32-bit atomic; FUTEX_WAKE does not touch memory.
     unsafe {

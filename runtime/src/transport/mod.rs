@@ -23,7 +23,7 @@ mod world_watch;
 use std::path::PathBuf;
 use std::process::Command;
 
-pub use agent::{AgentLink, TickFrame};
+pub use agent::{AgentLink, Tick};
 pub use run::{RUN_ROOTS_DIR, RunSpec};
 pub use sync_block::MAX_ROBOTS;
 pub use world::{CommandStatus, DeathNotices, LinkConfig, TickOutcome, WorldLink};

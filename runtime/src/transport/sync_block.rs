@@ -259,11 +259,13 @@ impl SyncBlock {
     }
 
     /// The current tick.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn tick(&self) -> u64 {
         self.header().tick.load(Ordering::Acquire)
     }
 
     /// Whether the world has ended the run.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn stopped(&self) -> bool {
         self.header().stop.0.load(Ordering::Acquire) != 0
     }
@@ -310,6 +312,7 @@ impl SyncBlock {
 
     /// Hands `tick` on from `robot` to the next robot of its chain, if any; called by the agent that answered
     /// and by the death notice of an agent that may have died before it could.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn pass_on(&self, robot: u32, tick: u64) {
         let next = robot + 1;
         if next < self.capacity && !self.starts_chain(next) {
@@ -320,6 +323,7 @@ impl SyncBlock {
     /// Wakes `robot` for `tick`, and the robots after it in its chain up to the first one with a live agent,
     /// which relays further itself. Robots without a live agent are still woken: a thawed agent whose death
     /// notice is not yet withdrawn may answer.
+    #[unsafe(link_section = "swarm_hot")]
     fn relay_from(&self, robot: u32, tick: u64) {
         let mut next = robot;
         loop {
@@ -338,6 +342,7 @@ impl SyncBlock {
         robot.is_multiple_of(self.relay_len)
     }
 
+    #[unsafe(link_section = "swarm_hot")]
     fn wake_robot(&self, robot: u32, tick: u64) {
         let go = &self.slot(robot).go;
         go.store(tick as u32, Ordering::Release);
@@ -372,6 +377,7 @@ impl SyncBlock {
 
     /// Accounts for `robot` in `tick` unless it already was; returns whether this call counted it. The call
     /// that completes the count wakes the world.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn claim(&self, robot: u32, tick: u64) -> bool {
         if self.slot(robot).answered.swap(tick, Ordering::AcqRel) == tick {
             return false;
@@ -512,6 +518,7 @@ impl SyncBlock {
 
     /// Whether `robot` has a connected agent and no death notice. The death flag is read sequentially
     /// consistent for [`SyncBlock::start_chain`]'s pairing with `mark_dead`.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn has_agent(&self, robot: u32) -> bool {
         let slot = self.slot(robot);
         slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::SeqCst) == 0
@@ -605,6 +612,7 @@ impl SyncBlock {
 
     /// The relay word of `robot`: read it before checking for an open tick, then [`SyncBlock::wait_relay`] on
     /// the value read, so that no relay between the check and the wait is missed.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn relay_word(&self, robot: u32) -> u32 {
         self.slot(robot).go.load(Ordering::Acquire)
     }
@@ -614,6 +622,7 @@ impl SyncBlock {
     /// With `world_gone` (set by a [`WorldWatch`](super::world_watch::WorldWatch), which also changes the
     /// relay word) it sleeps without a timeout; without, it checks every [`WORLD_CHECK`] of silence that the
     /// world process still exists.
+    #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn wait_relay(
         &self,
         robot: u32,
