@@ -498,3 +498,23 @@ fn hand_placed_robots_take_their_place_in_file_order() {
         ]
     );
 }
+
+#[test]
+fn agents_are_pinned_unless_the_system_element_says_false() {
+    let with_system = |system: &str| {
+        let text = format!(
+            r#"<argos-configuration>
+  <framework>{system}<experiment ticks_per_second="10" random_seed="3"/></framework>
+  <controllers><c id="k"/></controllers>
+  <arena size="4,4,1"><e-puck id="e"><body position="0,0,0"/><controller config="k"/></e-puck></arena>
+  <physics_engines><dynamics2d id="p"/></physics_engines>
+</argos-configuration>"#
+        );
+        let (exp, _) = Experiment::parse("pin.argos", &text).expect("valid");
+        exp.framework.pin_agents
+    };
+    assert!(with_system(""));
+    assert!(with_system(r#"<system threads="0"/>"#));
+    assert!(with_system(r#"<system pin_threads_to_cores="true"/>"#));
+    assert!(!with_system(r#"<system pin_threads_to_cores="false"/>"#));
+}

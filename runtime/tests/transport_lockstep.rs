@@ -406,3 +406,60 @@ fn an_agent_exits_on_its_own_when_the_world_process_dies() {
         "the agent says why: {stderr}"
     );
 }
+
+/// The CPUs `pid`'s main thread may run on (`Cpus_allowed_list` of `/proc/<pid>/status`, ranges expanded).
+fn allowed_cpus(pid: u32) -> Vec<usize> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("read the status");
+    let list = status
+        .lines()
+        .find_map(|line| line.strip_prefix("Cpus_allowed_list:"))
+        .expect("the status lists the allowed CPUs")
+        .trim();
+    list.split(',')
+        .flat_map(|range| {
+            let (first, last) = range.split_once('-').unwrap_or((range, range));
+            let parse = |cpu: &str| cpu.parse::<usize>().expect("a CPU number");
+            parse(first)..=parse(last)
+        })
+        .collect()
+}
+
+/// The CPUs of 8 agents in two chains of four, after they joined a world that does or does not pin them.
+fn agent_cpus_in_two_chains(pin_chains: bool) -> Vec<Vec<usize>> {
+    let mut run = Run::new();
+    let mut link_config = config(8, 10_000);
+    link_config.relays = 2;
+    link_config.pin_chains = pin_chains;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..8 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    run.children
+        .iter()
+        .map(|child| allowed_cpus(child.id()))
+        .collect()
+}
+
+#[test]
+fn each_relay_chain_runs_on_one_cpu_and_the_chains_take_the_cpus_in_turn() {
+    let allowed = allowed_cpus(std::process::id());
+    let cpus = agent_cpus_in_two_chains(true);
+    for (robot, cpus) in cpus.iter().enumerate() {
+        let chain = robot / 4;
+        assert_eq!(
+            cpus,
+            &vec![allowed[chain % allowed.len()]],
+            "robot {robot} of chain {chain}"
+        );
+    }
+}
+
+#[test]
+fn agents_of_a_world_that_does_not_pin_keep_every_cpu() {
+    let allowed = allowed_cpus(std::process::id());
+    for (robot, cpus) in agent_cpus_in_two_chains(false).iter().enumerate() {
+        assert_eq!(cpus, &allowed, "robot {robot}");
+    }
+}

@@ -146,6 +146,9 @@ impl Experiment {
 pub struct Framework {
     /// `<system threads>`: worker threads requested (0 = the main thread does everything). Informational.
     pub threads: u32,
+    /// `<system pin_threads_to_cores>`: whether each robot's agent process is pinned to one CPU by its relay
+    /// chain (ARGoS' attribute, for our processes); true when absent.
+    pub pin_agents: bool,
     /// `<experiment length>` in seconds; 0 means no limit (stop via loop functions).
     pub length_seconds: f64,
     /// `<experiment ticks_per_second>`: control steps per simulated second, always > 0.

@@ -406,6 +406,7 @@ impl Share {
         let spec = RunSpec::unique();
         let mut link_config = LinkConfig::new(count.max(1));
         link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);
+        link_config.pin_chains = assignment.pin_agents;
         let link = WorldLink::create(&spec, link_config)?;
         let publisher = session
             .declare_publisher(keys::replies(run, &options.name))

@@ -64,6 +64,8 @@ pub struct RemoteOptions {
     pub tick_deadline: Duration,
     /// How long a host may take to start its agents.
     pub join_timeout: Duration,
+    /// Whether the hosts' agents pin themselves to CPUs by relay chain.
+    pub pin_agents: bool,
     /// Largest payload accepted.
     pub max_payload: usize,
 }
@@ -547,6 +549,7 @@ impl RemoteHosts {
                 .collect(),
             tick_deadline_ms: (self.options.tick_deadline / 2).as_millis() as u64,
             join_timeout_ms: self.options.join_timeout.as_millis() as u64,
+            pin_agents: self.options.pin_agents,
             resume: if host.epoch > 1 {
                 host.share
                     .robots
@@ -1020,6 +1023,7 @@ mod tests {
             robots_override: None,
             tick_deadline: Duration::from_millis(300),
             join_timeout: Duration::from_secs(30),
+            pin_agents: true,
             max_payload: codec::DEFAULT_MAX_PAYLOAD,
         };
         RemoteHosts::start(options, robots, 0x5eed).expect("the world listens")

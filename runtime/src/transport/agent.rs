@@ -20,6 +20,7 @@ use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
 use iceoryx2::prelude::ipc;
 
 use super::TransportError;
+use super::placement;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
@@ -103,6 +104,14 @@ impl AgentLink {
         }
         match Self::connect(run, robot, &sync) {
             Ok(ports) => {
+                if sync.pins_chains() {
+                    match placement::pin_to_chain_cpu(robot, sync.relay_len()) {
+                        Ok(cpu) => {
+                            tracing::debug!(robot, cpu, "pinned to the CPU of its relay chain")
+                        }
+                        Err(e) => tracing::warn!(robot, "running unpinned: {e}"),
+                    }
+                }
                 // A replacement agent must not answer a tick its predecessor already answered.
                 let last_tick = sync.tick();
                 let watched = Arc::clone(&sync);

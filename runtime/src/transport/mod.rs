@@ -14,6 +14,7 @@
 mod agent;
 mod cleaner;
 pub(crate) mod futex;
+mod placement;
 mod run;
 mod services;
 mod sync_block;

@@ -32,7 +32,7 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 5;
+const LAYOUT_VERSION: u32 = 6;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -54,6 +54,8 @@ struct Header {
     world_pid: AtomicU32,
     /// Robots per relay chain: chain `c` is robots `c * relay_len ..` up to the next chain's first robot.
     relay_len: AtomicU32,
+    /// 1 when each agent pins itself to one CPU by its chain (`LinkConfig::pin_chains`).
+    pin_chains: AtomicU32,
     /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
     /// once its first robot's `chain_open` carries the tick.
     tick: AtomicU64,
@@ -116,12 +118,13 @@ impl SyncBlock {
         size_of::<Header>() + capacity as usize * size_of::<RobotSlot>()
     }
 
-    /// Creates the block of a run for `capacity` robots woken in chains of `relay_len` robots; fails if it
-    /// exists.
+    /// Creates the block of a run for `capacity` robots woken in chains of `relay_len` robots, whose agents pin
+    /// themselves to a CPU by chain if `pin_chains`; fails if it exists.
     pub(crate) fn create(
         path: &Path,
         capacity: u32,
         relay_len: u32,
+        pin_chains: bool,
     ) -> Result<SyncBlock, TransportError> {
         let io_err = |source| TransportError::SyncBlock {
             path: path.to_path_buf(),
@@ -140,6 +143,9 @@ impl SyncBlock {
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
         header.relay_len.store(block.relay_len, Ordering::Relaxed);
+        header
+            .pin_chains
+            .store(u32::from(pin_chains), Ordering::Relaxed);
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
@@ -262,6 +268,16 @@ impl SyncBlock {
     #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn tick(&self) -> u64 {
         self.header().tick.load(Ordering::Acquire)
+    }
+
+    /// Robots per relay chain.
+    pub(crate) fn relay_len(&self) -> u32 {
+        self.relay_len
+    }
+
+    /// Whether agents pin themselves to a CPU by relay chain.
+    pub(crate) fn pins_chains(&self) -> bool {
+        self.header().pin_chains.load(Ordering::Relaxed) != 0
     }
 
     /// Whether the world has ended the run.
@@ -715,7 +731,8 @@ mod tests {
         /// `robots` robots in chains of `relay_len`, every robot with a joined agent.
         fn joined(name: &str, robots: u32, relay_len: u32) -> TestBlock {
             let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-{name}", std::process::id()));
-            let block = SyncBlock::create(&path, robots, relay_len).expect("create the block");
+            let block =
+                SyncBlock::create(&path, robots, relay_len, false).expect("create the block");
             for robot in 0..robots {
                 let deadline = Instant::now() + Duration::from_secs(1);
                 assert!(matches!(

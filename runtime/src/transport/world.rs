@@ -51,6 +51,9 @@ pub struct LinkConfig {
     /// How long a tick may go without any answer before the world wakes every robot no relay has reached yet
     /// (default 5 ms): a frozen agent, or one killed before its death notice, holds up its chain until then.
     pub relay_stall: Duration,
+    /// Whether each agent pins itself to one CPU by its relay chain, the chains taking the CPUs in turn
+    /// (default true; see `transport::placement`).
+    pub pin_chains: bool,
 }
 
 impl LinkConfig {
@@ -63,6 +66,7 @@ impl LinkConfig {
             cleanup_interval: DEFAULT_CLEANUP_INTERVAL,
             relays: 0,
             relay_stall: DEFAULT_RELAY_STALL,
+            pin_chains: true,
         }
     }
 
@@ -201,6 +205,7 @@ impl WorldLink {
             &run.sync_block_path(),
             robots,
             config.relay_len(),
+            config.pin_chains,
         )?);
         tracing::debug!(run = run.name(), robots, "world link created");
         Ok(WorldLink {

@@ -115,6 +115,7 @@ pub fn thesis_example() -> Experiment {
         path: PathBuf::from("configs/obstacle_avoidance/thesis_example.argos"),
         framework: Framework {
             threads: 0,
+            pin_agents: true,
             length_seconds: 0.0,
             ticks_per_second: 20,
             random_seed: Some(124),

@@ -1,5 +1,5 @@
-//! `<framework>`: `<system threads>`, `<experiment length ticks_per_second random_seed>` and `<hosts>` (checked
-//! here, read by [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
+//! `<framework>`: `<system threads pin_threads_to_cores>`, `<experiment length ticks_per_second random_seed>`
+//! and `<hosts>` (checked here, read by [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
 
 use super::Ctx;
 use crate::config::model::{Element, Framework, Location};
@@ -10,6 +10,7 @@ const CHILDREN: &[&str] = &["system", "experiment", "profiling", "hosts"];
 pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     ctx.unknown_attributes(el, &[]);
     let mut threads = 0;
+    let mut pin_agents = true;
     let mut experiment: Option<(&Element, Location)> = None;
     let mut system_at: Option<Location> = None;
     for child in &el.children {
@@ -21,6 +22,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
                 system_at = Some(child.location);
                 ctx.unknown_attributes(child, &["threads", "method", "pin_threads_to_cores"]);
                 threads = ctx.attr(child, "threads").unwrap_or(0);
+                pin_agents = ctx.attr(child, "pin_threads_to_cores").unwrap_or(true);
             }
             "experiment" => match experiment {
                 Some((_, first)) => ctx.duplicate(child, &el.name, first),
@@ -81,6 +83,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     }
     Some(Framework {
         threads,
+        pin_agents,
         length_seconds,
         ticks_per_second,
         random_seed,

@@ -102,6 +102,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     if let Some(ms) = args.tick_deadline_ms {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
+    link_config.pin_chains = experiment.framework.pin_agents;
     let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
         None => {
             let link = WorldLink::create(&run, link_config)?;
@@ -110,7 +111,13 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         }
         Some(plan) => {
             let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
-            let link = Link::remote(plan, args, controllers, link_config.tick_deadline)?;
+            let link = Link::remote(
+                plan,
+                args,
+                controllers,
+                link_config.tick_deadline,
+                link_config.pin_chains,
+            )?;
             (link, faults::follow_launcher(None))
         }
     };

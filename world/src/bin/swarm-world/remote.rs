@@ -46,6 +46,7 @@ impl Link {
         args: &WorldArgs,
         controllers: Vec<String>,
         tick_deadline: Duration,
+        pin_agents: bool,
     ) -> anyhow::Result<Link> {
         let robots = controllers.len() as u32;
         let hosts = plan.place(robots);
@@ -60,6 +61,7 @@ impl Link {
             robots_override: args.robots,
             tick_deadline,
             join_timeout: Duration::from_millis(args.join_timeout_ms),
+            pin_agents,
             max_payload: DEFAULT_MAX_PAYLOAD,
         };
         let run = SystemTime::now()
