@@ -35,16 +35,23 @@ pub fn run_ended(run: &RunSpec) -> bool {
     sync_block::SyncBlock::open(&run.sync_block_path()).map_or(true, |sync| sync.stopped())
 }
 
-/// Prepares the command line of an agent process for the lockstep: switches off glibc's restartable-sequences
-/// registration (`glibc.pthread.rseq=0`, added to any `GLIBC_TUNABLES` already set). With it, the kernel
-/// rewrites the thread's rseq area in user memory on every return to user space after a context switch; an
-/// agent is switched in once per tick, and that write to a cold page cost ~6 % of the agents' CPU at
-/// N = 1,000 (docs/transport.md). Nothing in an agent uses rseq.
+/// Prepares the command line of an agent process for the lockstep with two glibc tunables, added to any
+/// `GLIBC_TUNABLES` already set (docs/transport.md):
+///
+/// - `glibc.pthread.rseq=0` switches off restartable-sequences registration. With it, the kernel rewrites the
+///   thread's rseq area in user memory on every return to user space after a context switch; an agent is
+///   switched in once per tick, and that write to a cold page cost ~6 % of the agents' CPU at N = 1,000.
+/// - `glibc.cpu.hwcaps=-AVX512F,...` keeps glibc's string functions off the AVX-512 registers. Once a process
+///   has used them, every context switch saves and restores their 2 KiB of state; an agent's `memcpy` of its
+///   frame was enough to keep that state live, and without it agents needed about 1.5 % less CPU per step
+///   at N = 1,000 (within-run comparison, docs/transport.md). The copies are a few hundred bytes, for which
+///   the AVX2 versions are as fast.
 pub fn tune_agent_command(command: &mut Command) -> &mut Command {
-    const NO_RSEQ: &str = "glibc.pthread.rseq=0";
+    const AGENT_TUNABLES: &str =
+        "glibc.pthread.rseq=0:glibc.cpu.hwcaps=-AVX512F,-AVX512VL,-AVX512BW,-AVX512DQ,-AVX512CD";
     let tunables = match std::env::var("GLIBC_TUNABLES") {
-        Ok(existing) if !existing.is_empty() => format!("{existing}:{NO_RSEQ}"),
-        _ => NO_RSEQ.to_string(),
+        Ok(existing) if !existing.is_empty() => format!("{existing}:{AGENT_TUNABLES}"),
+        _ => AGENT_TUNABLES.to_string(),
     };
     command.env("GLIBC_TUNABLES", tunables)
 }
