@@ -500,7 +500,7 @@ fn hand_placed_robots_take_their_place_in_file_order() {
 }
 
 #[test]
-fn agents_are_pinned_unless_the_system_element_says_false() {
+fn agents_are_pinned_and_real_time_unless_the_system_element_says_false() {
     let with_system = |system: &str| {
         let text = format!(
             r#"<argos-configuration>
@@ -510,11 +510,17 @@ fn agents_are_pinned_unless_the_system_element_says_false() {
   <physics_engines><dynamics2d id="p"/></physics_engines>
 </argos-configuration>"#
         );
-        let (exp, _) = Experiment::parse("pin.argos", &text).expect("valid");
-        exp.framework.pin_agents
+        let (exp, _) = Experiment::parse("system.argos", &text).expect("valid");
+        (exp.framework.pin_agents, exp.framework.realtime_priority)
     };
-    assert!(with_system(""));
-    assert!(with_system(r#"<system threads="0"/>"#));
-    assert!(with_system(r#"<system pin_threads_to_cores="true"/>"#));
-    assert!(!with_system(r#"<system pin_threads_to_cores="false"/>"#));
+    assert_eq!(with_system(""), (true, true));
+    assert_eq!(with_system(r#"<system threads="0"/>"#), (true, true));
+    assert_eq!(
+        with_system(r#"<system pin_threads_to_cores="false"/>"#),
+        (false, true)
+    );
+    assert_eq!(
+        with_system(r#"<system realtime_priority="false"/>"#),
+        (true, false)
+    );
 }

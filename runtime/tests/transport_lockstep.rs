@@ -4,7 +4,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 use swarm_runtime::transport::{
-    AgentLink, CommandStatus, LinkConfig, RunSpec, TransportError, WorldLink,
+    AgentLink, CommandStatus, LinkConfig, RunSpec, TransportError, WorldLink, priority,
 };
 
 const AGENT: &str = env!("CARGO_BIN_EXE_swarm-lockstep-agent");
@@ -461,5 +461,40 @@ fn agents_of_a_world_that_does_not_pin_keep_every_cpu() {
     let allowed = allowed_cpus(std::process::id());
     for (robot, cpus) in agent_cpus_in_two_chains(false).iter().enumerate() {
         assert_eq!(cpus, &allowed, "robot {robot}");
+    }
+}
+
+/// The scheduling policy and real-time priority of `pid`'s main thread (fields 41 and 40 of its stat line).
+fn scheduling(pid: u32) -> (i32, i32) {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).expect("read the stat line");
+    // Fields after the command name, which is in parentheses and may contain spaces.
+    let fields: Vec<&str> = stat[stat.rfind(')').expect("a command name") + 2..]
+        .split(' ')
+        .collect();
+    let field = |n: usize| fields[n - 3].parse::<i32>().expect("a number");
+    (field(41), field(40))
+}
+
+#[test]
+fn agents_of_a_realtime_world_run_first_in_first_out_when_the_system_allows_it() {
+    let allowed = std::thread::spawn(|| priority::enter_realtime(priority::AGENT_PRIORITY).is_ok())
+        .join()
+        .expect("the probe thread ends");
+    let mut run = Run::new();
+    let mut link_config = config(4, 10_000);
+    link_config.realtime = true;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..4 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 4);
+    let expected = if allowed {
+        (libc::SCHED_FIFO, priority::AGENT_PRIORITY)
+    } else {
+        (libc::SCHED_OTHER, 0)
+    };
+    for (robot, child) in run.children.iter().enumerate() {
+        assert_eq!(scheduling(child.id()), expected, "robot {robot}");
     }
 }

@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 
 use crate::bench::cpu::CpuMark;
 use crate::bench::stats::{median, quantile};
-use crate::transport::{LinkConfig, RunSpec, TransportError, WorldLink, tune_agent_command};
+use crate::transport::{
+    LinkConfig, RunSpec, TransportError, WorldLink, priority, tune_agent_command,
+};
 
 /// Ticks run before measuring, so that every agent is paged in and warm.
 const WARMUP_TICKS: usize = 100;
@@ -91,11 +93,25 @@ impl Drop for Agents {
     }
 }
 
-/// Runs the bare lockstep with `agent` (the `swarm-lockstep-agent` program).
+/// Runs the bare lockstep with `agent` (the `swarm-lockstep-agent` program), ticked by a thread of its own at
+/// real-time priority when the system allows it, as a world ticks (the calling thread keeps its priority).
 pub fn run(agent: &Path, options: &BareOptions) -> Result<BareReport, BareError> {
+    std::thread::scope(|scope| {
+        scope
+            .spawn(|| {
+                let realtime = priority::tick_at_realtime(true);
+                tick_bare(agent, options, realtime)
+            })
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
+}
+
+fn tick_bare(agent: &Path, options: &BareOptions, realtime: bool) -> Result<BareReport, BareError> {
     let robots = options.robots;
     let run = RunSpec::unique();
     let mut config = LinkConfig::new(robots);
+    config.realtime = realtime;
     config.tick_deadline = Duration::from_secs(10);
     if let Some(spin) = options.world_spin {
         config.spin = spin;

@@ -149,6 +149,9 @@ pub struct Framework {
     /// `<system pin_threads_to_cores>`: whether each robot's agent process is pinned to one CPU by its relay
     /// chain (ARGoS' attribute, for our processes); true when absent.
     pub pin_agents: bool,
+    /// `<system realtime_priority>` (ours): whether the world's ticking thread and the agents run at real-time
+    /// priority when the system allows it; true when absent.
+    pub realtime_priority: bool,
     /// `<experiment length>` in seconds; 0 means no limit (stop via loop functions).
     pub length_seconds: f64,
     /// `<experiment ticks_per_second>`: control steps per simulated second, always > 0.

@@ -36,6 +36,9 @@ pub struct Assignment {
     pub join_timeout_ms: u64,
     /// Whether the host's agents pin themselves to CPUs by relay chain (`<system pin_threads_to_cores>`).
     pub pin_agents: bool,
+    /// Whether the host's ticking thread and agents run at real-time priority if the host allows it
+    /// (`<system realtime_priority>`).
+    pub realtime_priority: bool,
     /// For a host that rejoins: each robot's last recorded supervisor snapshot and the tick it came with, in the
     /// order of `robots`, so its fresh agent resumes where the robot left off. Empty on the first assignment.
     pub resume: Vec<(u64, SupervisorSnapshot)>,

@@ -38,7 +38,9 @@ use crate::launcher::process_args::{AgentArgs, RunArgs};
 use crate::launcher::resume::{ResumeError, ResumePoint};
 use crate::launcher::run_dir;
 use crate::messages::{SensorFrame, SupervisorSnapshot};
-use crate::transport::{CommandStatus, LinkConfig, RunSpec, WorldLink, tune_agent_command};
+use crate::transport::{
+    CommandStatus, LinkConfig, RunSpec, WorldLink, priority, tune_agent_command,
+};
 
 /// How long agents get to exit by themselves when a share ends.
 const AGENT_EXIT_GRACE: Duration = Duration::from_secs(2);
@@ -407,6 +409,7 @@ impl Share {
         let mut link_config = LinkConfig::new(count.max(1));
         link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);
         link_config.pin_chains = assignment.pin_agents;
+        link_config.realtime = priority::tick_at_realtime(assignment.realtime_priority);
         let link = WorldLink::create(&spec, link_config)?;
         let publisher = session
             .declare_publisher(keys::replies(run, &options.name))

@@ -66,6 +66,8 @@ pub struct RemoteOptions {
     pub join_timeout: Duration,
     /// Whether the hosts' agents pin themselves to CPUs by relay chain.
     pub pin_agents: bool,
+    /// Whether the hosts tick and run their agents at real-time priority if they can.
+    pub realtime_priority: bool,
     /// Largest payload accepted.
     pub max_payload: usize,
 }
@@ -550,6 +552,7 @@ impl RemoteHosts {
             tick_deadline_ms: (self.options.tick_deadline / 2).as_millis() as u64,
             join_timeout_ms: self.options.join_timeout.as_millis() as u64,
             pin_agents: self.options.pin_agents,
+            realtime_priority: self.options.realtime_priority,
             resume: if host.epoch > 1 {
                 host.share
                     .robots
@@ -1024,6 +1027,7 @@ mod tests {
             tick_deadline: Duration::from_millis(300),
             join_timeout: Duration::from_secs(30),
             pin_agents: true,
+            realtime_priority: false,
             max_payload: codec::DEFAULT_MAX_PAYLOAD,
         };
         RemoteHosts::start(options, robots, 0x5eed).expect("the world listens")

@@ -20,11 +20,11 @@ use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
 use iceoryx2::prelude::ipc;
 
 use super::TransportError;
-use super::placement;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
 use super::world_watch::WorldWatch;
+use super::{placement, priority};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// How long a joining agent waits for the death notice of its robot's dead agent, and then for the world to
@@ -104,7 +104,8 @@ impl AgentLink {
         }
         match Self::connect(run, robot, &sync) {
             Ok(ports) => {
-                if sync.pins_chains() {
+                let placement = sync.placement();
+                if placement.pin_chains {
                     match placement::pin_to_chain_cpu(robot, sync.relay_len()) {
                         Ok(cpu) => {
                             tracing::debug!(robot, cpu, "pinned to the CPU of its relay chain")
@@ -116,6 +117,11 @@ impl AgentLink {
                 let last_tick = sync.tick();
                 let watched = Arc::clone(&sync);
                 let world_watch = WorldWatch::start(sync.world_pid(), move || watched.nudge(robot));
+                if placement.realtime
+                    && let Err(e) = priority::enter_realtime(priority::AGENT_PRIORITY)
+                {
+                    tracing::warn!(robot, "running at normal priority: {e}");
+                }
                 sync.announce_ready(robot);
                 Ok(AgentLink {
                     robot,

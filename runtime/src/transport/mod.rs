@@ -15,6 +15,7 @@ mod agent;
 mod cleaner;
 pub(crate) mod futex;
 mod placement;
+pub mod priority;
 mod run;
 mod services;
 mod sync_block;

@@ -32,7 +32,7 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 6;
+const LAYOUT_VERSION: u32 = 7;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -56,6 +56,8 @@ struct Header {
     relay_len: AtomicU32,
     /// 1 when each agent pins itself to one CPU by its chain (`LinkConfig::pin_chains`).
     pin_chains: AtomicU32,
+    /// 1 when each agent runs at real-time priority (`LinkConfig::realtime`).
+    realtime: AtomicU32,
     /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
     /// once its first robot's `chain_open` carries the tick.
     tick: AtomicU64,
@@ -91,6 +93,15 @@ struct RobotSlot {
     chain_open: AtomicU64,
 }
 
+/// Where and how the agents of a run run, as the world tells them in the block.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct AgentPlacement {
+    /// Each agent pins itself to the CPU of its relay chain.
+    pub(crate) pin_chains: bool,
+    /// Each agent runs at real-time priority.
+    pub(crate) realtime: bool,
+}
+
 /// A mapping of a run's sync block.
 pub(crate) struct SyncBlock {
     base: NonNull<u8>,
@@ -119,12 +130,13 @@ impl SyncBlock {
     }
 
     /// Creates the block of a run for `capacity` robots woken in chains of `relay_len` robots, whose agents pin
-    /// themselves to a CPU by chain if `pin_chains`; fails if it exists.
+    /// themselves to a CPU by chain if `placement.pin_chains` and run at real-time priority if
+    /// `placement.realtime`; fails if it exists.
     pub(crate) fn create(
         path: &Path,
         capacity: u32,
         relay_len: u32,
-        pin_chains: bool,
+        placement: AgentPlacement,
     ) -> Result<SyncBlock, TransportError> {
         let io_err = |source| TransportError::SyncBlock {
             path: path.to_path_buf(),
@@ -145,7 +157,10 @@ impl SyncBlock {
         header.relay_len.store(block.relay_len, Ordering::Relaxed);
         header
             .pin_chains
-            .store(u32::from(pin_chains), Ordering::Relaxed);
+            .store(u32::from(placement.pin_chains), Ordering::Relaxed);
+        header
+            .realtime
+            .store(u32::from(placement.realtime), Ordering::Relaxed);
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
@@ -275,9 +290,13 @@ impl SyncBlock {
         self.relay_len
     }
 
-    /// Whether agents pin themselves to a CPU by relay chain.
-    pub(crate) fn pins_chains(&self) -> bool {
-        self.header().pin_chains.load(Ordering::Relaxed) != 0
+    /// Where and how the run's agents run.
+    pub(crate) fn placement(&self) -> AgentPlacement {
+        let header = self.header();
+        AgentPlacement {
+            pin_chains: header.pin_chains.load(Ordering::Relaxed) != 0,
+            realtime: header.realtime.load(Ordering::Relaxed) != 0,
+        }
     }
 
     /// Whether the world has ended the run.
@@ -719,7 +738,7 @@ mod tests {
     use std::path::PathBuf;
     use std::time::{Duration, Instant};
 
-    use super::{JoinClaim, SyncBlock};
+    use super::{AgentPlacement, JoinClaim, SyncBlock};
 
     /// A sync block in shared memory whose file is removed when the test ends, passed or not.
     struct TestBlock {
@@ -731,8 +750,8 @@ mod tests {
         /// `robots` robots in chains of `relay_len`, every robot with a joined agent.
         fn joined(name: &str, robots: u32, relay_len: u32) -> TestBlock {
             let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-{name}", std::process::id()));
-            let block =
-                SyncBlock::create(&path, robots, relay_len, false).expect("create the block");
+            let block = SyncBlock::create(&path, robots, relay_len, AgentPlacement::default())
+                .expect("create the block");
             for robot in 0..robots {
                 let deadline = Instant::now() + Duration::from_secs(1);
                 assert!(matches!(

@@ -18,7 +18,7 @@ use super::TransportError;
 use super::cleaner::Cleaner;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
-use super::sync_block::{MAX_ROBOTS, SyncBlock};
+use super::sync_block::{AgentPlacement, MAX_ROBOTS, SyncBlock};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// Default time the world waits for the commands of one tick (see [`LinkConfig::tick_deadline`]).
@@ -54,6 +54,10 @@ pub struct LinkConfig {
     /// Whether each agent pins itself to one CPU by its relay chain, the chains taking the CPUs in turn
     /// (default true; see `transport::placement`).
     pub pin_chains: bool,
+    /// Whether each agent runs at real-time priority [`AGENT_PRIORITY`](super::priority::AGENT_PRIORITY)
+    /// (default false). Set it once the thread that ticks the link runs at
+    /// [`WORLD_PRIORITY`](super::priority::WORLD_PRIORITY): see [`priority`](super::priority).
+    pub realtime: bool,
 }
 
 impl LinkConfig {
@@ -67,6 +71,7 @@ impl LinkConfig {
             relays: 0,
             relay_stall: DEFAULT_RELAY_STALL,
             pin_chains: true,
+            realtime: false,
         }
     }
 
@@ -205,7 +210,10 @@ impl WorldLink {
             &run.sync_block_path(),
             robots,
             config.relay_len(),
-            config.pin_chains,
+            AgentPlacement {
+                pin_chains: config.pin_chains,
+                realtime: config.realtime,
+            },
         )?);
         tracing::debug!(run = run.name(), robots, "world link created");
         Ok(WorldLink {

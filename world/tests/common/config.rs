@@ -116,6 +116,7 @@ pub fn thesis_example() -> Experiment {
         framework: Framework {
             threads: 0,
             pin_agents: true,
+            realtime_priority: true,
             length_seconds: 0.0,
             ticks_per_second: 20,
             random_seed: Some(124),

@@ -1,4 +1,4 @@
-//! `<framework>`: `<system threads pin_threads_to_cores>`, `<experiment length ticks_per_second random_seed>`
+//! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>`, `<experiment length ticks_per_second random_seed>`
 //! and `<hosts>` (checked here, read by [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
 
 use super::Ctx;
@@ -11,6 +11,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     ctx.unknown_attributes(el, &[]);
     let mut threads = 0;
     let mut pin_agents = true;
+    let mut realtime_priority = true;
     let mut experiment: Option<(&Element, Location)> = None;
     let mut system_at: Option<Location> = None;
     for child in &el.children {
@@ -20,9 +21,18 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
                     ctx.duplicate(child, &el.name, first);
                 }
                 system_at = Some(child.location);
-                ctx.unknown_attributes(child, &["threads", "method", "pin_threads_to_cores"]);
+                ctx.unknown_attributes(
+                    child,
+                    &[
+                        "threads",
+                        "method",
+                        "pin_threads_to_cores",
+                        "realtime_priority",
+                    ],
+                );
                 threads = ctx.attr(child, "threads").unwrap_or(0);
                 pin_agents = ctx.attr(child, "pin_threads_to_cores").unwrap_or(true);
+                realtime_priority = ctx.attr(child, "realtime_priority").unwrap_or(true);
             }
             "experiment" => match experiment {
                 Some((_, first)) => ctx.duplicate(child, &el.name, first),
@@ -84,6 +94,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     Some(Framework {
         threads,
         pin_agents,
+        realtime_priority,
         length_seconds,
         ticks_per_second,
         random_seed,

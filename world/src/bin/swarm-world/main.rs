@@ -29,7 +29,7 @@ use swarm_runtime::launcher::hosts::{HostsArgs, HostsPlan};
 use swarm_runtime::launcher::process_args::WorldArgs;
 use swarm_runtime::launcher::world_report::WorldReport;
 use swarm_runtime::messages::ActuatorCommand;
-use swarm_runtime::transport::{LinkConfig, RunSpec, WorldLink};
+use swarm_runtime::transport::{LinkConfig, RunSpec, WorldLink, priority};
 use swarm_world::World;
 use swarm_world::recorder::Recorder;
 
@@ -103,6 +103,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         link_config.tick_deadline = Duration::from_millis(ms);
     }
     link_config.pin_chains = experiment.framework.pin_agents;
+    link_config.realtime = priority::tick_at_realtime(experiment.framework.realtime_priority);
     let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
         None => {
             let link = WorldLink::create(&run, link_config)?;
@@ -117,6 +118,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 controllers,
                 link_config.tick_deadline,
                 link_config.pin_chains,
+                experiment.framework.realtime_priority,
             )?;
             (link, faults::follow_launcher(None))
         }

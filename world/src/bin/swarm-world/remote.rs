@@ -47,6 +47,7 @@ impl Link {
         controllers: Vec<String>,
         tick_deadline: Duration,
         pin_agents: bool,
+        realtime_priority: bool,
     ) -> anyhow::Result<Link> {
         let robots = controllers.len() as u32;
         let hosts = plan.place(robots);
@@ -62,6 +63,7 @@ impl Link {
             tick_deadline,
             join_timeout: Duration::from_millis(args.join_timeout_ms),
             pin_agents,
+            realtime_priority,
             max_payload: DEFAULT_MAX_PAYLOAD,
         };
         let run = SystemTime::now()
