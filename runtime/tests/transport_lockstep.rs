@@ -476,7 +476,7 @@ fn scheduling(pid: u32) -> (i32, i32) {
 }
 
 #[test]
-fn agents_of_a_realtime_world_run_first_in_first_out_when_the_system_allows_it() {
+fn agents_of_a_realtime_world_run_round_robin_when_the_system_allows_it() {
     let allowed = std::thread::spawn(|| priority::enter_realtime(priority::AGENT_PRIORITY).is_ok())
         .join()
         .expect("the probe thread ends");
@@ -490,7 +490,7 @@ fn agents_of_a_realtime_world_run_first_in_first_out_when_the_system_allows_it()
     world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
     assert_eq!(world.tick_with(sense).expect("tick 1").answered, 4);
     let expected = if allowed {
-        (libc::SCHED_FIFO, priority::AGENT_PRIORITY)
+        (libc::SCHED_RR, priority::AGENT_PRIORITY)
     } else {
         (libc::SCHED_OTHER, 0)
     };

@@ -1,10 +1,11 @@
 //! Real-time scheduling for the lockstep: the thread that ticks the world (or a host's share) and every agent
-//! run under `SCHED_FIFO`, the world's thread one level above the agents.
+//! run under `SCHED_RR`, the world's thread one level above the agents.
 //!
 //! Under the normal scheduler every relay wake-up and every sleep of an agent goes through its fair-share
 //! bookkeeping (load averages, group runqueues, the choice whether the woken agent should preempt its waker),
-//! once per agent per tick. First-in-first-out real-time scheduling does none of that: a woken agent queues
-//! behind the one running on its CPU, which goes on until it sleeps, exactly the relay's order. The world's
+//! once per agent per tick. Round-robin real-time scheduling does none of that: a woken agent queues behind the
+//! one running on its CPU, which goes on until it sleeps, exactly the relay's order (an agent sleeps long before
+//! its 100 ms slice ends; the slice only bounds how long a runaway agent keeps the others of its CPU waiting). The world's
 //! thread, one level above, is never held up by an agent: it senses and starts every chain at once, and runs as
 //! soon as the last answer wakes it. At N = 1,000 on two CPUs this took the whole system from 91-96k to
 //! 120-134k robot-steps per second (docs/transport.md, "Real-time priorities").
@@ -16,21 +17,20 @@
 
 use std::io;
 
-/// `SCHED_FIFO` priority of the thread that ticks a world or a host's share.
+/// `SCHED_RR` priority of the thread that ticks a world or a host's share.
 pub const WORLD_PRIORITY: i32 = 2;
-/// `SCHED_FIFO` priority of an agent.
+/// `SCHED_RR` priority of an agent.
 pub const AGENT_PRIORITY: i32 = 1;
 
-/// Makes the calling thread `SCHED_FIFO` at `priority`; threads and processes it starts afterwards run under the
+/// Makes the calling thread `SCHED_RR` at `priority`; threads and processes it starts afterwards run under the
 /// normal policy.
 pub fn enter_realtime(priority: i32) -> io::Result<()> {
     let param = libc::sched_param {
         sched_priority: priority,
     };
     // SAFETY: sched_setscheduler only reads `param`; pid 0 is the calling thread.
-    let result = unsafe {
-        libc::sched_setscheduler(0, libc::SCHED_FIFO | libc::SCHED_RESET_ON_FORK, &param)
-    };
+    let result =
+        unsafe { libc::sched_setscheduler(0, libc::SCHED_RR | libc::SCHED_RESET_ON_FORK, &param) };
     if result == 0 {
         Ok(())
     } else {
@@ -48,7 +48,7 @@ pub fn tick_at_realtime(wanted: bool) -> bool {
     match enter_realtime(WORLD_PRIORITY) {
         Ok(()) => {
             tracing::info!(
-                "ticking and agents run at real-time priority (SCHED_FIFO {WORLD_PRIORITY} and {AGENT_PRIORITY})"
+                "ticking and agents run at real-time priority (SCHED_RR {WORLD_PRIORITY} and {AGENT_PRIORITY})"
             );
             true
         }
@@ -94,7 +94,7 @@ mod tests {
         .expect("the test thread ends");
         match seen {
             Ok((own, started)) => {
-                assert_eq!(own, (libc::SCHED_FIFO, AGENT_PRIORITY));
+                assert_eq!(own, (libc::SCHED_RR, AGENT_PRIORITY));
                 assert_eq!(started, (libc::SCHED_OTHER, 0), "reset on fork");
             }
             // Without CAP_SYS_NICE or an rtprio limit the call must fail cleanly, as runs expect.
