@@ -147,7 +147,10 @@ fn death_notice_from_another_thread_releases_the_waiting_tick() {
     let outcome = world
         .tick_with(|tick, first, frames| {
             sense(tick, first, frames);
-            started_tx.send(()).expect("notify");
+            // Once: the launcher thread ends after the first notice (the world senses each chain apart).
+            if first == 0 {
+                started_tx.send(()).expect("notify");
+            }
         })
         .expect("tick 2");
     launcher.join().expect("launcher thread");
@@ -177,7 +180,7 @@ fn frozen_agent_misses_the_deadline_while_the_others_keep_ticking() {
 /// answering from tick 2, after a tick 1 that every agent answered.
 fn two_chains_of_four_after_tick_1(run: &mut Run, deadline_ms: u64, frozen: u32) -> WorldLink {
     let mut link_config = config(8, deadline_ms);
-    link_config.relays = 2;
+    link_config.chains = 2;
     let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
     for robot in 0..8 {
         let extra: &[&str] = if robot == frozen {
@@ -193,10 +196,9 @@ fn two_chains_of_four_after_tick_1(run: &mut Run, deadline_ms: u64, frozen: u32)
 }
 
 #[test]
-fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after_it() {
+fn an_agent_that_stops_answering_holds_up_no_other_robot_of_its_chain() {
     let mut run = Run::new();
-    // Robot 1 stops answering, so no relay reaches 2 and 3; the world's rescue must wake them long before the
-    // deadline.
+    // Robot 1 stops answering; robots 2 and 3 of its chain answer long before the deadline.
     let mut world = two_chains_of_four_after_tick_1(&mut run, 5_000, 1);
     for tick in 2..=4 {
         let outcome = world.tick_with(sense).expect("tick");
@@ -206,10 +208,40 @@ fn frozen_agent_in_the_middle_of_a_relay_chain_does_not_hold_up_the_robots_after
             expect_echo(&world, robot, tick);
         }
     }
-    // Once the robot is reported dead, relays step over it.
+    // Once the robot is reported dead, ticks no longer wait for it.
     world.mark_dead(1).expect("death notice");
     let outcome = world.tick_with(sense).expect("tick 5");
     assert_eq!((outcome.answered, outcome.dead), (7, 1));
+}
+
+#[test]
+fn a_stopped_agent_holds_up_no_other_robot_of_its_chain() {
+    let mut run = Run::new();
+    // Two chains of two; robot 0's process is stopped (SIGSTOP, as `swarm ctl freeze` does). The stop signal
+    // takes it out of its chain's wait, so the world's one wake-up of chain 0 reaches robot 1's agent, which
+    // answers long before the deadline.
+    let mut link_config = config(4, 20_000);
+    link_config.chains = 2;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..4 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 4);
+    let stopped = libc::pid_t::try_from(run.children[0].id()).expect("a pid");
+    // SAFETY: kill(2) with a valid signal on our own child.
+    assert_eq!(unsafe { libc::kill(stopped, libc::SIGSTOP) }, 0);
+    // As the fault driver does for a frozen robot: ticks stop waiting for it.
+    world.mark_dead(0).expect("death notice");
+    for tick in 2..=6 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!((outcome.answered, outcome.dead), (3, 1), "tick {tick}");
+        for robot in 1..4 {
+            expect_echo(&world, robot, tick);
+        }
+    }
+    // SAFETY: as above.
+    assert_eq!(unsafe { libc::kill(stopped, libc::SIGCONT) }, 0);
 }
 
 #[test]
@@ -428,7 +460,7 @@ fn allowed_cpus(pid: u32) -> Vec<usize> {
 fn agent_cpus_in_two_chains(pin_chains: bool) -> Vec<Vec<usize>> {
     let mut run = Run::new();
     let mut link_config = config(8, 10_000);
-    link_config.relays = 2;
+    link_config.chains = 2;
     link_config.pin_chains = pin_chains;
     let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
     for robot in 0..8 {
@@ -443,7 +475,7 @@ fn agent_cpus_in_two_chains(pin_chains: bool) -> Vec<Vec<usize>> {
 }
 
 #[test]
-fn each_relay_chain_runs_on_one_cpu_and_the_chains_take_the_cpus_in_turn() {
+fn each_chain_runs_on_one_cpu_and_the_chains_take_the_cpus_in_turn() {
     let allowed = allowed_cpus(std::process::id());
     let cpus = agent_cpus_in_two_chains(true);
     for (robot, cpus) in cpus.iter().enumerate() {

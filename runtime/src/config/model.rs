@@ -146,7 +146,7 @@ impl Experiment {
 pub struct Framework {
     /// `<system threads>`: worker threads requested (0 = the main thread does everything). Informational.
     pub threads: u32,
-    /// `<system pin_threads_to_cores>`: whether each robot's agent process is pinned to one CPU by its relay
+    /// `<system pin_threads_to_cores>`: whether each robot's agent process is pinned to one CPU by its
     /// chain (ARGoS' attribute, for our processes); true when absent.
     pub pin_agents: bool,
     /// `<system realtime_priority>` (ours): whether the world's ticking thread and the agents run at real-time

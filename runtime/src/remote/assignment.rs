@@ -34,7 +34,7 @@ pub struct Assignment {
     pub tick_deadline_ms: u64,
     /// How long the host may take to start its agents (milliseconds).
     pub join_timeout_ms: u64,
-    /// Whether the host's agents pin themselves to CPUs by relay chain (`<system pin_threads_to_cores>`).
+    /// Whether the host's agents pin themselves to CPUs by chain (`<system pin_threads_to_cores>`).
     pub pin_agents: bool,
     /// Whether the host's ticking thread and agents run at real-time priority if the host allows it
     /// (`<system realtime_priority>`).

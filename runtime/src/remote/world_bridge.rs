@@ -64,7 +64,7 @@ pub struct RemoteOptions {
     pub tick_deadline: Duration,
     /// How long a host may take to start its agents.
     pub join_timeout: Duration,
-    /// Whether the hosts' agents pin themselves to CPUs by relay chain.
+    /// Whether the hosts' agents pin themselves to CPUs by chain.
     pub pin_agents: bool,
     /// Whether the hosts tick and run their agents at real-time priority if they can.
     pub realtime_priority: bool,

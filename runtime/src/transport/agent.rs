@@ -1,6 +1,6 @@
-//! An agent's side of the lockstep: join a run for one robot, sleep until a relay hands it an open tick, load
-//! the robot's own frame from the frame board, answer by writing the command board of its robot and hand the
-//! tick on to the next robot of its chain.
+//! An agent's side of the lockstep: join a run for one robot, sleep on its chain's wake word until the chain
+//! starts an open tick (waking the rest of the chain if it is the first to run), load the robot's own frame
+//! from the frame board, and answer by writing the command board of its robot.
 //!
 //! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
 //! never answer a tick the world has not opened yet, nor the same tick twice.
@@ -30,7 +30,7 @@ use crate::messages::{ActuatorCommand, SensorFrame};
 /// How long a joining agent waits for the death notice of its robot's dead agent, and then for the world to
 /// replace the robot's command board.
 const BOARD_WAIT: Duration = Duration::from_secs(30);
-/// Default number of polls of the relay word before an agent sleeps on it (see [`AgentLink::set_spin`]).
+/// Default number of polls of the chain's wake word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
 /// A tick the world opened for this agent's robot: the robot's frame, answered at most once with
@@ -51,7 +51,7 @@ impl Tick<'_> {
     }
 
     /// Sends `command` as the robot's answer to this tick, with its `tick` and `robot` fields set here, and
-    /// hands the tick on to the next robot of the chain.
+    /// counts the robot as answered (the last answer of the tick wakes the world).
     #[unsafe(link_section = "swarm_hot")]
     pub fn answer(self, command: &mut ActuatorCommand) {
         let link = self.link;
@@ -59,7 +59,6 @@ impl Tick<'_> {
         command.tick = tick;
         command.robot = link.robot;
         link.ports.command_entry.update_with_copy(*command);
-        link.sync.pass_on(link.robot, tick);
         link.sync.claim(link.robot, tick);
     }
 }
@@ -106,10 +105,8 @@ impl AgentLink {
             Ok(ports) => {
                 let placement = sync.placement();
                 if placement.pin_chains {
-                    match placement::pin_to_chain_cpu(robot, sync.relay_len()) {
-                        Ok(cpu) => {
-                            tracing::debug!(robot, cpu, "pinned to the CPU of its relay chain")
-                        }
+                    match placement::pin_to_chain_cpu(robot, sync.chain_len()) {
+                        Ok(cpu) => tracing::debug!(robot, cpu, "pinned to the CPU of its chain"),
                         Err(e) => tracing::warn!(robot, "running unpinned: {e}"),
                     }
                 }
@@ -200,7 +197,7 @@ impl AgentLink {
         self.robot
     }
 
-    /// How many times the agent polls its relay word before it sleeps on it (default 0: the lockstep benchmark
+    /// How many times the agent polls its chain's wake word before it sleeps on it (default 0: the lockstep benchmark
     /// on 2 cores is fastest without agent polling). Polling only pays when every agent has a core to itself.
     pub fn set_spin(&mut self, polls: u32) {
         self.spin = polls;
@@ -212,23 +209,24 @@ impl AgentLink {
     #[unsafe(link_section = "swarm_hot")]
     pub fn next_tick(&mut self) -> Result<Option<Tick<'_>>, TransportError> {
         loop {
-            let seen = self.sync.relay_word(self.robot);
+            let seen = self.sync.chain_word(self.robot);
             if self.sync.stopped() {
                 return Ok(None);
             }
             let open = self.sync.tick();
             if open > self.last_tick {
                 // The world opens the tick before it writes the frames: until this robot's chain starts, the
-                // frame is still the last tick's, and the chain's start changes the relay word.
+                // frame is still the last tick's, and the chain's start changes its wake word.
                 self.frame = *self.ports.frame_entry.get();
                 if self.frame.tick == open {
                     self.last_tick = open;
+                    self.sync.spread(self.robot, open);
                     return Ok(Some(Tick { link: self }));
                 }
             }
             let world_gone = self.world_watch.as_ref().map(WorldWatch::gone);
             self.sync
-                .wait_relay(self.robot, seen, self.spin, world_gone)
+                .wait_chain(self.robot, seen, self.spin, world_gone)
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }

@@ -1,10 +1,10 @@
 //! Local transport of the lockstep tick protocol over iceoryx2 shared memory.
 //!
 //! One tick: the world writes every robot's [`SensorFrame`](crate::messages::SensorFrame) into its entry of an
-//! iceoryx2 blackboard in shared memory, opens the tick and wakes the first robot of each relay chain. Each
-//! agent loads its own frame entry, writes its [`ActuatorCommand`](crate::messages::ActuatorCommand) into its
-//! robot's own command board, wakes the next robot of its chain and bumps one shared acknowledgement counter;
-//! the last one wakes the world. The world waits on that one counter until every robot is accounted for or the
+//! iceoryx2 blackboard in shared memory, opens the tick and wakes one agent of each chain of robots, which wakes
+//! the rest of its chain. Each agent loads its own frame entry, writes its
+//! [`ActuatorCommand`](crate::messages::ActuatorCommand) into its robot's own command board and bumps one shared
+//! acknowledgement counter; the last one wakes the world. The world waits on that one counter until every robot is accounted for or the
 //! tick's deadline passes, then reads each robot's command from its own board, so its view never depends on
 //! arrival order.
 //! docs/transport.md explains the choices.

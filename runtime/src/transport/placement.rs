@@ -1,24 +1,23 @@
-//! Where an agent runs: each relay chain on one CPU.
+//! Where an agent runs: each chain on one CPU.
 //!
-//! A relay hands the tick from one agent to the next of its chain, and the woken agent is best run on the CPU
-//! the waker is about to leave. Left to itself, the scheduler often wakes it on the other CPU instead: in a
-//! virtual machine that means an interrupt to a halted CPU, an idle gap on both, and an agent whose cache lines
-//! are on the other core. Pinned, a chain's agents take turns on one CPU, warm in its cache, and the chains
-//! share the CPUs the run may use, in turn. At 100 robots on two CPUs this took the whole system from about
+//! The agents of a chain are woken together and run one after the other; left to itself, the scheduler often
+//! moved the next one to the other CPU: in a virtual machine that means an interrupt to a halted CPU, an idle
+//! gap on both, and an agent whose cache lines are on the other core. Pinned, a chain's agents take turns on
+//! one CPU, warm in its cache, and the chains share the CPUs the run may use, in turn. At 100 robots on two CPUs this took the whole system from about
 //! 90k to 150k robot-steps per second (docs/transport.md, "Agents pinned by chain").
 //!
 //! Pinning is an optimisation only: when the CPUs cannot be read or set, the agent runs unpinned and says so.
 
 use std::io;
 
-/// Pins the calling thread to the CPU of `robot`'s relay chain (chains of `relay_len` robots) among the CPUs
+/// Pins the calling thread to the CPU of `robot`'s chain (chains of `chain_len` robots) among the CPUs
 /// this thread may use now; returns that CPU.
-pub(crate) fn pin_to_chain_cpu(robot: u32, relay_len: u32) -> io::Result<usize> {
+pub(crate) fn pin_to_chain_cpu(robot: u32, chain_len: u32) -> io::Result<usize> {
     let allowed = allowed_cpus()?;
     if allowed.is_empty() {
         return Err(io::Error::other("no CPU is allowed"));
     }
-    let chain = (robot / relay_len.max(1)) as usize;
+    let chain = (robot / chain_len.max(1)) as usize;
     let cpu = allowed[chain % allowed.len()];
     // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET and sched_setaffinity only read and write it.
     unsafe {

@@ -1,18 +1,18 @@
 //! The lockstep sync block: a small file in the run's shared memory holding the futex words of the tick protocol
 //! and one slot per robot.
 //!
-//! Only control words live here (tick, per-robot relay words, acknowledgement counter, join and death flags);
+//! Only control words live here (tick, per-chain wake words, acknowledgement counter, join and death flags);
 //! frames and commands travel through iceoryx2 blackboards. The world creates the block, agents map it. Every
 //! field is an atomic, so the mapping is shared freely between threads and processes; a zero-filled block is a
 //! valid empty block.
 //!
-//! Agents are woken by relays rather than by one broadcast: the robots form chains of consecutive indices,
-//! the world wakes each chain's first robot, and every agent that answers wakes the next robot of its chain.
-//! Each agent sleeps on its own `go` word, so a wake-up is a targeted one from the process that just ran,
-//! usually on the same core, instead of one system call that makes every agent runnable at once (measured in
-//! docs/transport.md). A dead robot never breaks its chain: relays step over robots without a live agent, and a
-//! death notice hands the tick on in place of the dead agent; a frozen one is stepped over by the world's rescue
-//! (see [`SyncBlock::rescue`]).
+//! Agents are woken chain by chain: the robots form chains of consecutive indices, and every agent of a chain
+//! sleeps on the chain's wake word. Once a chain's frames are in place the world sets the word to the tick and
+//! wakes one of its agents; the first agent of the chain to run in the tick wakes all the others with one system
+//! call ([`SyncBlock::spread`]). So neither the world nor an agent makes a system call per woken agent, and the
+//! chain's agents, pinned to one CPU, queue there and run one after the other (measured in docs/transport.md).
+//! No robot depends on another to be woken, so a dead or frozen agent holds up nobody; only when the world's one
+//! wake-up went to a frozen agent does a chain wait, for the world's rescue (see [`SyncBlock::rescue`]).
 //!
 //! The acknowledgement word packs the tick it belongs to (top bits) with the number of robots accounted for in
 //! that tick (bottom bits). An answer is counted only while the word still carries its tick, so a late answer
@@ -32,12 +32,12 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 7;
+const LAYOUT_VERSION: u32 = 8;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
 const COUNT_MASK: u32 = (1 << COUNT_BITS) - 1;
-/// How long an agent sleeps on its relay word before it checks that the world still exists.
+/// How long an agent sleeps on its chain's wake word before it checks that the world still exists.
 const WORLD_CHECK: Duration = Duration::from_secs(1);
 /// How often a replacement agent re-checks a claim held by a dead agent while it waits for the death notice.
 const CLAIM_POLL: Duration = Duration::from_millis(10);
@@ -52,14 +52,14 @@ struct Header {
     capacity: AtomicU32,
     /// Process id of the world, so that agents notice when it is gone.
     world_pid: AtomicU32,
-    /// Robots per relay chain: chain `c` is robots `c * relay_len ..` up to the next chain's first robot.
-    relay_len: AtomicU32,
+    /// Robots per chain: chain `c` is robots `c * chain_len ..` up to the next chain's first robot.
+    chain_len: AtomicU32,
     /// 1 when each agent pins itself to one CPU by its chain (`LinkConfig::pin_chains`).
     pin_chains: AtomicU32,
     /// 1 when each agent runs at real-time priority (`LinkConfig::realtime`).
     realtime: AtomicU32,
     /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
-    /// once its first robot's `chain_open` carries the tick.
+    /// once its wake word carries the tick.
     tick: AtomicU64,
     /// Tick tag and answer count; the world sleeps on it.
     acks: LineWord,
@@ -71,12 +71,10 @@ struct Header {
     board_requests: LineWord,
 }
 
-/// Per-robot control words, one cache line per robot: the robot's agent, its predecessor in the chain and the
-/// world write here from different cores.
+/// Per-robot control words, one cache line per robot: the robot's agent and the world write here from
+/// different cores.
 #[repr(C, align(64))]
 struct RobotSlot {
-    /// Low 32 bits of the last tick handed to this robot by a relay; its agent sleeps on it.
-    go: AtomicU32,
     /// Last tick this robot was accounted for.
     answered: AtomicU64,
     /// 1 while an agent owns this robot.
@@ -88,15 +86,17 @@ struct RobotSlot {
     /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
     /// death (a board's single writer slot stays taken by a dead writer, so a replacement gets a fresh board).
     board: AtomicU32,
-    /// In the first robot of a chain only: the last tick whose frames of the chain are in place and whose
-    /// relay has started. A relay into the chain before that would wake an agent that finds no frame.
-    chain_open: AtomicU64,
+    /// In the first robot of a chain only: the chain's wake word, the low 32 bits of the last tick whose frames
+    /// of the chain are in place. Every agent of the chain sleeps on it.
+    chain_go: AtomicU32,
+    /// In the first robot of a chain only: the last tick in which an agent of the chain woke the others.
+    chain_woken: AtomicU64,
 }
 
 /// Where and how the agents of a run run, as the world tells them in the block.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct AgentPlacement {
-    /// Each agent pins itself to the CPU of its relay chain.
+    /// Each agent pins itself to the CPU of its chain.
     pub(crate) pin_chains: bool,
     /// Each agent runs at real-time priority.
     pub(crate) realtime: bool,
@@ -107,8 +107,8 @@ pub(crate) struct SyncBlock {
     base: NonNull<u8>,
     len: usize,
     capacity: u32,
-    /// Robots per relay chain (a copy of the header's, which never changes).
-    relay_len: u32,
+    /// Robots per chain (a copy of the header's, which never changes).
+    chain_len: u32,
 }
 
 // SAFETY: the mapping is only accessed through atomics, and it stays mapped until the SyncBlock is dropped.
@@ -129,13 +129,13 @@ impl SyncBlock {
         size_of::<Header>() + capacity as usize * size_of::<RobotSlot>()
     }
 
-    /// Creates the block of a run for `capacity` robots woken in chains of `relay_len` robots, whose agents pin
+    /// Creates the block of a run for `capacity` robots woken in chains of `chain_len` robots, whose agents pin
     /// themselves to a CPU by chain if `placement.pin_chains` and run at real-time priority if
     /// `placement.realtime`; fails if it exists.
     pub(crate) fn create(
         path: &Path,
         capacity: u32,
-        relay_len: u32,
+        chain_len: u32,
         placement: AgentPlacement,
     ) -> Result<SyncBlock, TransportError> {
         let io_err = |source| TransportError::SyncBlock {
@@ -150,11 +150,11 @@ impl SyncBlock {
             .map_err(io_err)?;
         let len = Self::size_for(capacity);
         file.set_len(len as u64).map_err(io_err)?;
-        let block = Self::map(path, &file, len, capacity, relay_len.max(1))?;
+        let block = Self::map(path, &file, len, capacity, chain_len.max(1))?;
         let header = block.header();
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
-        header.relay_len.store(block.relay_len, Ordering::Relaxed);
+        header.chain_len.store(block.chain_len, Ordering::Relaxed);
         header
             .pin_chains
             .store(u32::from(placement.pin_chains), Ordering::Relaxed);
@@ -215,9 +215,9 @@ impl SyncBlock {
                 "{file_len} bytes cannot hold {capacity} robots ({len} bytes)"
             )));
         }
-        let relay_len = header.relay_len.load(Ordering::Relaxed).max(1);
+        let chain_len = header.chain_len.load(Ordering::Relaxed).max(1);
         drop(header_only);
-        Self::map(path, &file, len, capacity, relay_len)
+        Self::map(path, &file, len, capacity, chain_len)
     }
 
     fn map(
@@ -225,7 +225,7 @@ impl SyncBlock {
         file: &std::fs::File,
         len: usize,
         capacity: u32,
-        relay_len: u32,
+        chain_len: u32,
     ) -> Result<SyncBlock, TransportError> {
         // SAFETY: a fresh shared mapping of an open file descriptor; the kernel picks the address.
         let ptr = unsafe {
@@ -252,7 +252,7 @@ impl SyncBlock {
             base,
             len,
             capacity,
-            relay_len,
+            chain_len,
         })
     }
 
@@ -285,9 +285,9 @@ impl SyncBlock {
         self.header().tick.load(Ordering::Acquire)
     }
 
-    /// Robots per relay chain.
-    pub(crate) fn relay_len(&self) -> u32 {
-        self.relay_len
+    /// Robots per chain.
+    pub(crate) fn chain_len(&self) -> u32 {
+        self.chain_len
     }
 
     /// Where and how the run's agents run.
@@ -325,76 +325,49 @@ impl SyncBlock {
 
     /// The chains, each as the range of its robots.
     pub(crate) fn chains(&self) -> impl Iterator<Item = std::ops::Range<u32>> + use<> {
-        let (capacity, len) = (self.capacity, self.relay_len);
+        let (capacity, len) = (self.capacity, self.chain_len);
         (0..capacity)
             .step_by(len as usize)
             .map(move |first| first..(first + len).min(capacity))
     }
 
-    /// Starts the relay of `tick` in the chain whose first robot is `first`: the chain's frames are in place.
+    /// Starts `tick` in the chain whose first robot is `first`: the chain's frames are in place. Wakes one of
+    /// the chain's agents, which wakes the others ([`SyncBlock::spread`]).
     pub(crate) fn start_chain(&self, first: u32, tick: u64) {
-        // SeqCst pairs with `mark_dead`: either the relay below sees the death flag and steps over the robot,
-        // or the death notice sees the chain started and hands the tick on itself.
-        self.slot(first).chain_open.store(tick, Ordering::SeqCst);
-        self.relay_from(first, tick);
-    }
-
-    /// Whether the chain of `robot` has started `tick`.
-    fn chain_started(&self, robot: u32, tick: u64) -> bool {
-        let first = robot - robot % self.relay_len;
-        self.slot(first).chain_open.load(Ordering::SeqCst) == tick
-    }
-
-    /// Hands `tick` on from `robot` to the next robot of its chain, if any; called by the agent that answered
-    /// and by the death notice of an agent that may have died before it could.
-    #[unsafe(link_section = "swarm_hot")]
-    pub(crate) fn pass_on(&self, robot: u32, tick: u64) {
-        let next = robot + 1;
-        if next < self.capacity && !self.starts_chain(next) {
-            self.relay_from(next, tick);
-        }
-    }
-
-    /// Wakes `robot` for `tick`, and the robots after it in its chain up to the first one with a live agent,
-    /// which relays further itself. Robots without a live agent are still woken: a thawed agent whose death
-    /// notice is not yet withdrawn may answer.
-    #[unsafe(link_section = "swarm_hot")]
-    fn relay_from(&self, robot: u32, tick: u64) {
-        let mut next = robot;
-        loop {
-            self.wake_robot(next, tick);
-            if self.has_agent(next) {
-                return;
-            }
-            next += 1;
-            if next >= self.capacity || self.starts_chain(next) {
-                return;
-            }
-        }
-    }
-
-    fn starts_chain(&self, robot: u32) -> bool {
-        robot.is_multiple_of(self.relay_len)
-    }
-
-    #[unsafe(link_section = "swarm_hot")]
-    fn wake_robot(&self, robot: u32, tick: u64) {
-        let go = &self.slot(robot).go;
+        let go = &self.slot(first).chain_go;
         go.store(tick as u32, Ordering::Release);
-        futex::wake(go, i32::MAX);
+        futex::wake(go, 1);
     }
 
-    /// The world's remedy for a relay stuck at an agent that neither answers nor has a death notice (frozen,
-    /// or killed and not yet reported): wakes every robot not yet accounted for in `tick` that no relay has
-    /// reached. Returns how many were woken.
+    /// The first robot of `robot`'s chain.
+    fn chain_of(&self, robot: u32) -> u32 {
+        robot - robot % self.chain_len
+    }
+
+    /// Called by an agent that found its frame of `tick`: the first agent of the chain to do so wakes all the
+    /// others of the chain with one system call. Returns whether this call did.
+    #[unsafe(link_section = "swarm_hot")]
+    pub(crate) fn spread(&self, robot: u32, tick: u64) -> bool {
+        let first = self.slot(self.chain_of(robot));
+        if first.chain_woken.swap(tick, Ordering::AcqRel) == tick {
+            return false;
+        }
+        futex::wake(&first.chain_go, i32::MAX);
+        true
+    }
+
+    /// The world's remedy for a chain whose one wake-up went to an agent that cannot run (frozen, or killed
+    /// and not yet reported): wakes every agent of each started chain that still has robots not accounted for
+    /// in `tick`. Returns how many chains it woke.
     pub(crate) fn rescue(&self, tick: u64) -> u32 {
         let mut woken = 0;
-        for robot in 0..self.capacity {
-            let slot = self.slot(robot);
-            if slot.answered.load(Ordering::Acquire) != tick
-                && slot.go.load(Ordering::Acquire) != tick as u32
-            {
-                self.wake_robot(robot, tick);
+        for chain in self.chains() {
+            let go = &self.slot(chain.start).chain_go;
+            let waiting = chain
+                .clone()
+                .any(|robot| self.slot(robot).answered.load(Ordering::Acquire) != tick);
+            if waiting && go.load(Ordering::Acquire) == tick as u32 {
+                futex::wake(go, i32::MAX);
                 woken += 1;
             }
         }
@@ -405,8 +378,8 @@ impl SyncBlock {
     pub(crate) fn stop(&self) {
         let header = self.header();
         header.stop.0.store(1, Ordering::Release);
-        for robot in 0..self.capacity {
-            self.nudge(robot);
+        for chain in self.chains() {
+            self.nudge(chain.start);
         }
     }
 
@@ -441,7 +414,7 @@ impl SyncBlock {
     }
 
     /// Waits until every robot is accounted for in `tick` or `deadline` passes, spinning for at most `spin`
-    /// first. Whenever no answer arrives for `stall`, robots the relays have not reached are woken directly
+    /// first. Whenever no answer arrives for `stall`, the chains still waiting are woken again
     /// ([`SyncBlock::rescue`]). Returns whether every robot was accounted for.
     pub(crate) fn wait_answers(
         &self,
@@ -470,7 +443,7 @@ impl SyncBlock {
                 tracing::debug!(
                     tick,
                     woken,
-                    "relay stalled; woke the robots it had not reached"
+                    "answers stalled; woke the chains still waiting"
                 );
                 progress.1 = now;
             }
@@ -495,11 +468,6 @@ impl SyncBlock {
         futex::wake(&slot.owner, i32::MAX);
         let tick = self.header().tick.load(Ordering::SeqCst);
         self.claim(robot, tick);
-        if tick > 0 && self.chain_started(robot, tick) {
-            // The agent may have died holding the relay: hand the tick on in its place. A chain not started
-            // yet steps over the robot when it starts.
-            self.pass_on(robot, tick);
-        }
     }
 
     /// A replacement agent for `robot` asks for a fresh command board: its dead predecessor may still hold the
@@ -551,12 +519,10 @@ impl SyncBlock {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
     }
 
-    /// Whether `robot` has a connected agent and no death notice. The death flag is read sequentially
-    /// consistent for [`SyncBlock::start_chain`]'s pairing with `mark_dead`.
-    #[unsafe(link_section = "swarm_hot")]
+    /// Whether `robot` has a connected agent and no death notice.
     pub(crate) fn has_agent(&self, robot: u32) -> bool {
         let slot = self.slot(robot);
-        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::SeqCst) == 0
+        slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
     }
 
     /// The process id of `robot`'s agent, if one owns the robot.
@@ -645,27 +611,29 @@ impl SyncBlock {
         joined.load(Ordering::Acquire)
     }
 
-    /// The relay word of `robot`: read it before checking for an open tick, then [`SyncBlock::wait_relay`] on
-    /// the value read, so that no relay between the check and the wait is missed.
+    /// The wake word of `robot`'s chain: read it before checking for an open tick, then
+    /// [`SyncBlock::wait_chain`] on the value read, so that no wake-up between the check and the wait is missed.
     #[unsafe(link_section = "swarm_hot")]
-    pub(crate) fn relay_word(&self, robot: u32) -> u32 {
-        self.slot(robot).go.load(Ordering::Acquire)
+    pub(crate) fn chain_word(&self, robot: u32) -> u32 {
+        self.slot(self.chain_of(robot))
+            .chain_go
+            .load(Ordering::Acquire)
     }
 
-    /// Waits until `robot`'s relay word differs from `seen` (a relay, or the end of the run), polling `spin`
-    /// times before blocking; `Err(pid)` when the world process is gone (killed without stopping the run).
-    /// With `world_gone` (set by a [`WorldWatch`](super::world_watch::WorldWatch), which also changes the
-    /// relay word) it sleeps without a timeout; without, it checks every [`WORLD_CHECK`] of silence that the
+    /// Waits until the wake word of `robot`'s chain differs from `seen` (a tick started, or the end of the run),
+    /// polling `spin` times before blocking; `Err(pid)` when the world process is gone (killed without stopping
+    /// the run). With `world_gone` (set by a [`WorldWatch`](super::world_watch::WorldWatch), which also changes
+    /// the wake word) it sleeps without a timeout; without, it checks every [`WORLD_CHECK`] of silence that the
     /// world process still exists.
     #[unsafe(link_section = "swarm_hot")]
-    pub(crate) fn wait_relay(
+    pub(crate) fn wait_chain(
         &self,
         robot: u32,
         seen: u32,
         spin: u32,
         world_gone: Option<&AtomicBool>,
     ) -> Result<(), u32> {
-        let go = &self.slot(robot).go;
+        let go = &self.slot(self.chain_of(robot)).chain_go;
         for _ in 0..spin {
             if go.load(Ordering::Acquire) != seen {
                 return Ok(());
@@ -691,10 +659,10 @@ impl SyncBlock {
         Ok(())
     }
 
-    /// Wakes `robot`'s agent out of [`SyncBlock::wait_relay`] by changing its relay word. Only for the end of a
-    /// run (stopped, or the world gone), when the word's value means nothing any more.
+    /// Wakes the agents of `robot`'s chain out of [`SyncBlock::wait_chain`] by changing the chain's wake word.
+    /// Only for the end of a run (stopped, or the world gone), when the word's value means nothing any more.
     pub(crate) fn nudge(&self, robot: u32) {
-        let go = &self.slot(robot).go;
+        let go = &self.slot(self.chain_of(robot)).chain_go;
         go.fetch_add(1, Ordering::AcqRel);
         futex::wake(go, i32::MAX);
     }
@@ -747,10 +715,10 @@ mod tests {
     }
 
     impl TestBlock {
-        /// `robots` robots in chains of `relay_len`, every robot with a joined agent.
-        fn joined(name: &str, robots: u32, relay_len: u32) -> TestBlock {
+        /// `robots` robots in chains of `chain_len`, every robot with a joined agent.
+        fn joined(name: &str, robots: u32, chain_len: u32) -> TestBlock {
             let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-{name}", std::process::id()));
-            let block = SyncBlock::create(&path, robots, relay_len, AgentPlacement::default())
+            let block = SyncBlock::create(&path, robots, chain_len, AgentPlacement::default())
                 .expect("create the block");
             for robot in 0..robots {
                 let deadline = Instant::now() + Duration::from_secs(1);
@@ -771,32 +739,39 @@ mod tests {
     }
 
     #[test]
-    fn a_death_notice_hands_the_tick_on_only_in_a_chain_that_has_started() {
-        let test = TestBlock::joined("death-notice-relay", 8, 4);
+    fn a_started_chain_changes_only_its_own_wake_word_and_one_agent_spreads_it() {
+        let test = TestBlock::joined("chain-start", 8, 4);
         let block = &test.block;
         block.open_tick(1);
         block.start_chain(0, 1);
-        assert_eq!(block.relay_word(0), 1);
-
-        // Chain 0 has started: the notice hands the tick on from robot 1 to robot 2.
-        block.mark_dead(1);
-        assert_eq!(block.relay_word(2), 1);
-
-        // Chain 1 has not: robot 6's frame is not in place, so nothing may wake it for tick 1 yet.
+        assert_eq!((block.chain_word(3), block.chain_word(4)), (1, 0));
+        // The first agent of chain 0 to run wakes the others; later ones, and later calls, do not.
+        assert!(block.spread(2, 1));
+        assert!(!block.spread(0, 1));
+        // A death notice wakes nobody: no robot waits for another one's answer.
         block.mark_dead(5);
-        assert_eq!(block.relay_word(6), 0);
-
+        assert_eq!(block.chain_word(4), 0);
         block.start_chain(4, 1);
-        assert_eq!((block.relay_word(4), block.relay_word(6)), (1, 0));
-        // Robot 4's agent answers and relays; the relay steps over dead robot 5 to robot 6, not further.
-        block.pass_on(4, 1);
-        assert_eq!(
-            (
-                block.relay_word(5),
-                block.relay_word(6),
-                block.relay_word(7)
-            ),
-            (1, 1, 0)
-        );
+        assert_eq!(block.chain_word(7), 1);
+        assert!(block.spread(7, 1));
+        assert!(block.spread(1, 2), "a new tick is spread again");
+    }
+
+    #[test]
+    fn the_rescue_wakes_started_chains_that_still_wait_for_answers() {
+        let test = TestBlock::joined("chain-rescue", 8, 4);
+        let block = &test.block;
+        block.open_tick(1);
+        block.start_chain(0, 1);
+        assert_eq!(block.rescue(1), 1, "chain 0 started, chain 1 not yet");
+        for robot in 0..4 {
+            block.claim(robot, 1);
+        }
+        block.start_chain(4, 1);
+        assert_eq!(block.rescue(1), 1, "chain 0 is done, chain 1 still waits");
+        for robot in 4..8 {
+            block.claim(robot, 1);
+        }
+        assert_eq!(block.rescue(1), 0);
     }
 }

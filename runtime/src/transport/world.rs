@@ -25,9 +25,9 @@ use crate::messages::{ActuatorCommand, SensorFrame};
 pub const DEFAULT_TICK_DEADLINE: Duration = Duration::from_millis(500);
 /// Default time the world spins before it blocks on the answer counter (see [`LinkConfig::spin`]).
 pub const DEFAULT_SPIN: Duration = Duration::from_micros(20);
-/// Default time without any answer after which the world wakes the robots a stuck relay has not reached (see
-/// [`LinkConfig::relay_stall`]).
-pub const DEFAULT_RELAY_STALL: Duration = Duration::from_millis(5);
+/// Default time without any answer after which the world wakes the chains still waiting again (see
+/// [`LinkConfig::chain_stall`]).
+pub const DEFAULT_CHAIN_STALL: Duration = Duration::from_millis(5);
 /// Default number of ticks between two dead-node cleanups (see [`LinkConfig::cleanup_interval`]).
 pub const DEFAULT_CLEANUP_INTERVAL: u64 = 1000;
 
@@ -45,13 +45,15 @@ pub struct LinkConfig {
     /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice or a
     /// replacement agent's request triggers one at once as well. Removals run on a thread of their own.
     pub cleanup_interval: u64,
-    /// Number of relay chains the robots are woken in (0: chosen from the robot count, see
-    /// [`LinkConfig::relay_len`]). The world wakes the first robot of each chain; each agent wakes the next.
-    pub relays: u32,
-    /// How long a tick may go without any answer before the world wakes every robot no relay has reached yet
-    /// (default 5 ms): a frozen agent, or one killed before its death notice, holds up its chain until then.
-    pub relay_stall: Duration,
-    /// Whether each agent pins itself to one CPU by its relay chain, the chains taking the CPUs in turn
+    /// Number of chains the robots are woken in (0: chosen from the robot count, see
+    /// [`LinkConfig::chain_len`]). The world wakes one agent of each chain once its frames are written; that
+    /// agent wakes the rest of the chain.
+    pub chains: u32,
+    /// How long a tick may go without any answer before the world wakes the agents of every chain still
+    /// waiting (default 5 ms): a chain whose one wake-up went to a frozen agent, or to one killed before its
+    /// death notice, waits until then.
+    pub chain_stall: Duration,
+    /// Whether each agent pins itself to one CPU by its chain, the chains taking the CPUs in turn
     /// (default true; see `transport::placement`).
     pub pin_chains: bool,
     /// Whether each agent runs at real-time priority [`AGENT_PRIORITY`](super::priority::AGENT_PRIORITY)
@@ -68,19 +70,19 @@ impl LinkConfig {
             tick_deadline: DEFAULT_TICK_DEADLINE,
             spin: DEFAULT_SPIN,
             cleanup_interval: DEFAULT_CLEANUP_INTERVAL,
-            relays: 0,
-            relay_stall: DEFAULT_RELAY_STALL,
+            chains: 0,
+            chain_stall: DEFAULT_CHAIN_STALL,
             pin_chains: true,
             realtime: false,
         }
     }
 
-    /// Robots per relay chain. Unless [`LinkConfig::relays`] says otherwise, one chain per 100 robots, at
-    /// least 2 and at most 16: the range where the relay beat a single broadcast wake-up on this machine kind
+    /// Robots per chain. Unless [`LinkConfig::chains`] says otherwise, one chain per 100 robots, at least 2 and
+    /// at most 16: enough chains to spread over the CPUs, each woken with one system call
     /// (docs/transport.md).
-    pub fn relay_len(&self) -> u32 {
+    pub fn chain_len(&self) -> u32 {
         let robots = self.robots.max(1);
-        let chains = match self.relays {
+        let chains = match self.chains {
             0 => (robots / 100).clamp(2, 16),
             chosen => chosen,
         };
@@ -209,7 +211,7 @@ impl WorldLink {
         let sync = Arc::new(SyncBlock::create(
             &run.sync_block_path(),
             robots,
-            config.relay_len(),
+            config.chain_len(),
             AgentPlacement {
                 pin_chains: config.pin_chains,
                 realtime: config.realtime,
@@ -364,7 +366,7 @@ impl WorldLink {
             sync.start_chain(chain.start, tick);
         }
         let deadline = Instant::now() + self.config.tick_deadline;
-        if !sync.wait_answers(tick, self.config.spin, self.config.relay_stall, deadline) {
+        if !sync.wait_answers(tick, self.config.spin, self.config.chain_stall, deadline) {
             tracing::debug!(tick, "tick deadline passed with answers missing");
         }
         let outcome = self.collect(tick);
@@ -453,23 +455,23 @@ impl Drop for WorldLink {
 mod tests {
     use super::LinkConfig;
 
-    fn relay_len(robots: u32, relays: u32) -> u32 {
+    fn chain_len(robots: u32, chains: u32) -> u32 {
         LinkConfig {
-            relays,
+            chains,
             ..LinkConfig::new(robots)
         }
-        .relay_len()
+        .chain_len()
     }
 
     #[test]
     fn chains_follow_the_robot_count_unless_chosen() {
-        assert_eq!(relay_len(1, 0), 1);
-        assert_eq!(relay_len(10, 0), 5);
-        assert_eq!(relay_len(100, 0), 50);
-        assert_eq!(relay_len(1000, 0), 100);
-        assert_eq!(relay_len(2000, 0), 125);
-        assert_eq!(relay_len(5000, 0), 313);
-        assert_eq!(relay_len(8, 3), 3);
-        assert_eq!(relay_len(4, 9), 1);
+        assert_eq!(chain_len(1, 0), 1);
+        assert_eq!(chain_len(10, 0), 5);
+        assert_eq!(chain_len(100, 0), 50);
+        assert_eq!(chain_len(1000, 0), 100);
+        assert_eq!(chain_len(2000, 0), 125);
+        assert_eq!(chain_len(5000, 0), 313);
+        assert_eq!(chain_len(8, 3), 3);
+        assert_eq!(chain_len(4, 9), 1);
     }
 }

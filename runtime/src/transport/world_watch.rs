@@ -1,6 +1,6 @@
 //! Noticing that the world process ended, without a timed wait on the tick path.
 //!
-//! An agent sleeps on its relay word between ticks. A timed futex wait arms and cancels a kernel timer on every
+//! An agent sleeps on its chain's wake word between ticks. A timed futex wait arms and cancels a kernel timer on every
 //! tick (the bare lockstep at N = 1,000 had a ~3 % lower tick p50 without it, BENCHMARKS.md), so agents sleep
 //! without a timeout and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the
 //! world process, and when the world ends it sets [`WorldWatch::gone`] and calls the agent's wake-up. Where no
