@@ -1,11 +1,18 @@
 //! Linux futex wait/wake on a 32-bit word in shared memory.
 //!
-//! The lockstep protocol parks each agent on its own word and the world on one counter; the words live in a
+//! The lockstep protocol parks each agent on its chain's word and the world on one counter; the words live in a
 //! `MAP_SHARED` mapping, so the shared (non-private) futex operations are used. This module must never spin:
 //! callers decide how long to spin before they block here.
+//!
+//! The calls go through rustix's raw Linux backend rather than glibc's `syscall()`: the `syscall` instruction is
+//! inlined into the caller, in the agents' hot section, so an agent returning from its wait does not first walk
+//! the page tables for glibc's wrapper and its GOT entry (docs/transport.md, "Agent code locality").
 
 use std::sync::atomic::AtomicU32;
 use std::time::Duration;
+
+use rustix::io::Errno;
+use rustix::thread::futex::{self, Flags, Timespec};
 
 /// Blocks while `word` still holds `expected`, for at most `timeout` (forever when `None`).
 ///
@@ -14,29 +21,13 @@ use std::time::Duration;
 /// long silence without reading the clock on every wake-up.
 #[unsafe(link_section = "swarm_hot")]
 pub fn wait(word: &AtomicU32, expected: u32, timeout: Option<Duration>) -> Waited {
-    let spec = timeout.map(|t| libc::timespec {
-        tv_sec: libc::time_t::try_from(t.as_secs()).unwrap_or(libc::time_t::MAX),
-        tv_nsec: libc::c_long::from(t.subsec_nanos()),
+    let spec = timeout.map(|t| Timespec {
+        tv_sec: i64::try_from(t.as_secs()).unwrap_or(i64::MAX),
+        tv_nsec: i64::from(t.subsec_nanos()),
     });
-    let spec_ptr = spec
-        .as_ref()
-        .map_or(std::ptr::null(), |s| s as *const libc::timespec);
-    // SAFETY: `word` is a live, aligned 32-bit atomic; the kernel only reads it. The timespec outlives the call.
-    let result = unsafe {
-        libc::syscall(
-            libc::SYS_futex,
-            word.as_ptr(),
-            libc::FUTEX_WAIT,
-            expected,
-            spec_ptr,
-            std::ptr::null::<u32>(),
-            0u32,
-        )
-    };
-    if result == -1 && std::io::Error::last_os_error().raw_os_error() == Some(libc::ETIMEDOUT) {
-        Waited::TimedOut
-    } else {
-        Waited::Woken
+    match futex::wait(word, Flags::empty(), expected, spec.as_ref()) {
+        Err(Errno::TIMEDOUT) => Waited::TimedOut,
+        _ => Waited::Woken,
     }
 }
 
@@ -57,16 +48,6 @@ pub enum Waited {
 /// Wakes at most `count` processes blocked in [`wait`] on `word` (`i32::MAX` wakes all).
 #[unsafe(link_section = "swarm_hot")]
 pub fn wake(word: &AtomicU32, count: i32) {
-    // SAFETY: `word` is a live, aligned 32-bit atomic; FUTEX_WAKE does not touch memory.
-    unsafe {
-        libc::syscall(
-            libc::SYS_futex,
-            word.as_ptr(),
-            libc::FUTEX_WAKE,
-            count,
-            std::ptr::null::<libc::timespec>(),
-            std::ptr::null::<u32>(),
-            0u32,
-        );
-    }
+    // FUTEX_WAKE fails only for an unmapped or misaligned word, which a `&AtomicU32` cannot be.
+    let _ = futex::wake(word, Flags::empty(), u32::try_from(count).unwrap_or(0));
 }
