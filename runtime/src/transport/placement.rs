@@ -1,10 +1,10 @@
 //! Where an agent runs: each chain on one CPU.
 //!
-//! The agents of a chain are woken together and run one after the other; left to itself, the scheduler often
-//! moved the next one to the other CPU: in a virtual machine that means an interrupt to a halted CPU, an idle
-//! gap on both, and an agent whose cache lines are on the other core. Pinned, a chain's agents take turns on
-//! one CPU, warm in its cache, and the chains share the CPUs the run may use, in turn. At 100 robots on two CPUs this took the whole system from about
-//! 90k to 150k robot-steps per second (docs/transport.md, "Agents pinned by chain").
+//! The agents of a chain are woken together and run one after the other; left to itself, the scheduler often moved the
+//! next one to the other CPU: in a virtual machine that means an interrupt to a halted CPU, an idle gap on both, and an
+//! agent whose cache lines are on the other core. Pinned, a chain's agents take turns on one CPU, warm in its cache,
+//! and the chains share the CPUs the run may use, in turn. At 100 robots on two CPUs this took the whole system from
+//! 149k to 196k robot-steps per second in alternated runs (docs/transport.md, "Agents pinned by chain").
 //!
 //! Pinning is an optimisation only: when the CPUs cannot be read or set, the agent runs unpinned and says so.
 

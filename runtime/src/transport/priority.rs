@@ -1,13 +1,14 @@
 //! Real-time scheduling for the lockstep: the thread that ticks the world (or a host's share) and every agent
 //! run under `SCHED_RR`, the world's thread one level above the agents.
 //!
-//! Under the normal scheduler every wake-up and every sleep of an agent goes through its fair-share bookkeeping
-//! (load averages, group runqueues, the choice whether the woken agent should preempt its waker), once per agent
-//! per tick. Round-robin real-time scheduling does none of that: woken agents queue behind the one running on
-//! their CPU, which goes on until it sleeps (long before its 100 ms slice ends; the slice only bounds how long a
-//! runaway agent keeps the others of its CPU waiting). The world's thread, one level above, is never held up by an agent: it senses and starts every chain at once, and runs as
-//! soon as the last answer wakes it. At N = 1,000 on two CPUs this took the whole system from 91-96k to
-//! 120-134k robot-steps per second (docs/transport.md, "Real-time priorities").
+//! Under the normal scheduler every wake-up and every sleep of an agent goes through its fair-share bookkeeping (load
+//! averages, group runqueues, the choice whether the woken agent should preempt its waker), once per agent per tick.
+//! Round-robin real-time scheduling does none of that: woken agents queue behind the one running on their CPU, which
+//! goes on until it sleeps (long before its 100 ms slice ends; the slice only bounds how long a runaway agent keeps the
+//! others of its CPU waiting). The world's thread, one level above, is never held up by an agent: it senses and starts
+//! every chain at once, and runs as soon as the last answer wakes it. At N = 1,000 on two CPUs this took the whole
+//! system from 125.5k to 142.5k robot-steps per second (median of four alternated pairs; docs/transport.md, "Real-time
+//! priorities").
 //!
 //! Every thread that enters real time does so with `SCHED_RESET_ON_FORK`: the threads and processes it starts
 //! afterwards (the recorder, agents spawned by a host) run normally until they choose otherwise. Real-time
