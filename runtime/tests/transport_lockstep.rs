@@ -456,18 +456,26 @@ fn allowed_cpus(pid: u32) -> Vec<usize> {
         .collect()
 }
 
+/// Starts a world with `link_config` and one agent per robot, and runs the first tick: by then every agent has
+/// joined and settled where and how it runs.
+fn agents_after_one_tick(run: &mut Run, link_config: LinkConfig) -> WorldLink {
+    let robots = link_config.robots;
+    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
+    for robot in 0..robots {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, robots);
+    world
+}
+
 /// The CPUs of 8 agents in two chains of four, after they joined a world that does or does not pin them.
 fn agent_cpus_in_two_chains(pin_chains: bool) -> Vec<Vec<usize>> {
     let mut run = Run::new();
     let mut link_config = config(8, 10_000);
     link_config.chains = 2;
     link_config.pin_chains = pin_chains;
-    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
-    for robot in 0..8 {
-        run.spawn(robot, &[]);
-    }
-    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
-    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 8);
+    let _world = agents_after_one_tick(&mut run, link_config);
     run.children
         .iter()
         .map(|child| allowed_cpus(child.id()))
@@ -515,12 +523,7 @@ fn agents_of_a_realtime_world_run_round_robin_when_the_system_allows_it() {
     let mut run = Run::new();
     let mut link_config = config(4, 10_000);
     link_config.realtime = true;
-    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
-    for robot in 0..4 {
-        run.spawn(robot, &[]);
-    }
-    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
-    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 4);
+    let _world = agents_after_one_tick(&mut run, link_config);
     let expected = if allowed {
         (libc::SCHED_RR, priority::AGENT_PRIORITY)
     } else {
