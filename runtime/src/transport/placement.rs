@@ -17,8 +17,7 @@ pub(crate) fn pin_to_chain_cpu(robot: u32, chain_len: u32) -> io::Result<usize> 
     if allowed.is_empty() {
         return Err(io::Error::other("no CPU is allowed"));
     }
-    let chain = (robot / chain_len.max(1)) as usize;
-    let cpu = allowed[chain % allowed.len()];
+    let cpu = chain_cpu((robot / chain_len.max(1)) as usize, &allowed);
     // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET and sched_setaffinity only read and write it.
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
@@ -28,6 +27,28 @@ pub(crate) fn pin_to_chain_cpu(robot: u32, chain_len: u32) -> io::Result<usize> 
         }
     }
     Ok(cpu)
+}
+
+/// The CPU of chain `chain` among `allowed` (not empty): the chains take the CPUs in turn.
+fn chain_cpu(chain: usize, allowed: &[usize]) -> usize {
+    allowed[chain % allowed.len()]
+}
+
+/// The CPU each of `chains` chains runs on when its agents pin themselves, for agents that inherit the calling
+/// thread's CPUs (the launcher's or the host's, like the world's); `None` when they cannot be read.
+pub(crate) fn chain_cpus(chains: usize) -> Option<Vec<usize>> {
+    let allowed = allowed_cpus().ok().filter(|allowed| !allowed.is_empty())?;
+    Some(
+        (0..chains)
+            .map(|chain| chain_cpu(chain, &allowed))
+            .collect(),
+    )
+}
+
+/// The CPU the calling thread runs on at this moment; `None` where the kernel does not say.
+pub(crate) fn current_cpu() -> Option<usize> {
+    // SAFETY: sched_getcpu takes no arguments and touches no memory of ours.
+    usize::try_from(unsafe { libc::sched_getcpu() }).ok()
 }
 
 /// The CPUs the calling thread may run on, ascending.
@@ -70,5 +91,17 @@ mod tests {
             allowed[1 % allowed.len()],
             "chain 1 takes the next allowed CPU"
         );
+        assert_eq!(
+            chain_cpus(2),
+            Some(vec![first, second]),
+            "the world expects each chain where its agents pin themselves"
+        );
+    }
+
+    #[test]
+    fn the_current_cpu_is_one_the_thread_may_use() {
+        let allowed = allowed_cpus().expect("the test may read its CPUs");
+        let here = current_cpu().expect("Linux says where a thread runs");
+        assert!(allowed.contains(&here), "{here} among {allowed:?}");
     }
 }

@@ -16,6 +16,7 @@ use iceoryx2::prelude::ipc;
 
 use super::TransportError;
 use super::cleaner::Cleaner;
+use super::placement;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY};
 use super::sync_block::{AgentPlacement, MAX_ROBOTS, SyncBlock};
@@ -192,6 +193,8 @@ pub struct WorldLink {
     last_cleanup: u64,
     cleaner: Cleaner,
     node: Node<ipc::Service>,
+    /// The CPU of each chain's agents, when they pin themselves ([`LinkConfig::pin_chains`]); empty otherwise.
+    chain_cpus: Vec<usize>,
 }
 
 impl WorldLink {
@@ -217,6 +220,11 @@ impl WorldLink {
                 realtime: config.realtime,
             },
         )?);
+        let chain_cpus = if config.pin_chains {
+            placement::chain_cpus(sync.chains().count()).unwrap_or_default()
+        } else {
+            Vec::new()
+        };
         tracing::debug!(run = run.name(), robots, "world link created");
         Ok(WorldLink {
             tick: 0,
@@ -234,6 +242,7 @@ impl WorldLink {
             cleaner,
             node,
             config,
+            chain_cpus,
         })
     }
 
@@ -356,14 +365,36 @@ impl WorldLink {
         let sync = &self.deaths.sync;
         sync.open_tick(tick);
         self.tick = tick;
-        for chain in sync.chains() {
-            let robots = chain.start as usize..chain.end as usize;
-            let frames = &mut self.frames[robots.clone()];
-            SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
-            for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
-                entry.update_with_copy(*frame);
+        // The chains whose agents share this thread's CPU go last and start together once every frame is out:
+        // under the normal scheduler the first agent woken on this CPU would preempt the world's sensing, and
+        // hold up the chains of the other CPUs with it.
+        let here = if self.chain_cpus.is_empty() {
+            None
+        } else {
+            placement::current_cpu()
+        };
+        let on_this_cpu =
+            |chain: usize| here.is_some() && self.chain_cpus.get(chain).copied() == here;
+        for this_cpus_pass in [false, true] {
+            for (index, chain) in sync.chains().enumerate() {
+                if on_this_cpu(index) != this_cpus_pass {
+                    continue;
+                }
+                let robots = chain.start as usize..chain.end as usize;
+                let frames = &mut self.frames[robots.clone()];
+                SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
+                for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
+                    entry.update_with_copy(*frame);
+                }
+                if !this_cpus_pass {
+                    sync.start_chain(chain.start, tick);
+                }
             }
-            sync.start_chain(chain.start, tick);
+        }
+        for (index, chain) in sync.chains().enumerate() {
+            if on_this_cpu(index) {
+                sync.start_chain(chain.start, tick);
+            }
         }
         let deadline = Instant::now() + self.config.tick_deadline;
         if !sync.wait_answers(tick, self.config.spin, self.config.chain_stall, deadline) {
