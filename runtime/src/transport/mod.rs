@@ -4,9 +4,9 @@
 //! iceoryx2 blackboard in shared memory, opens the tick and wakes one agent of each chain of robots, which wakes
 //! the rest of its chain. Each agent loads its own frame entry, writes its
 //! [`ActuatorCommand`](crate::messages::ActuatorCommand) into its robot's own command board and bumps one shared
-//! acknowledgement counter; the last one wakes the world. The world waits on that one counter until every robot is accounted for or the
-//! tick's deadline passes, then reads each robot's command from its own board, so its view never depends on
-//! arrival order.
+//! acknowledgement counter; the last one wakes the world. The world waits on that one counter until every robot
+//! is accounted for or the tick's deadline passes, then reads each robot's command from its own board, so its
+//! view never depends on arrival order.
 //! docs/transport.md explains the choices.
 //!
 //! [`WorldLink`] is the world's side, [`AgentLink`] an agent's side, [`RunSpec`] names a run and cleans it up.

@@ -14,9 +14,6 @@ use std::io;
 /// this thread may use now; returns that CPU.
 pub(crate) fn pin_to_chain_cpu(robot: u32, chain_len: u32) -> io::Result<usize> {
     let allowed = allowed_cpus()?;
-    if allowed.is_empty() {
-        return Err(io::Error::other("no CPU is allowed"));
-    }
     let cpu = chain_cpu((robot / chain_len.max(1)) as usize, &allowed);
     // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET and sched_setaffinity only read and write it.
     unsafe {
@@ -29,7 +26,7 @@ pub(crate) fn pin_to_chain_cpu(robot: u32, chain_len: u32) -> io::Result<usize> 
     Ok(cpu)
 }
 
-/// The CPU of chain `chain` among `allowed` (not empty): the chains take the CPUs in turn.
+/// The CPU of chain `chain` among `allowed` (from [`allowed_cpus`]): the chains take the CPUs in turn.
 fn chain_cpu(chain: usize, allowed: &[usize]) -> usize {
     allowed[chain % allowed.len()]
 }
@@ -37,7 +34,7 @@ fn chain_cpu(chain: usize, allowed: &[usize]) -> usize {
 /// The CPU each of `chains` chains runs on when its agents pin themselves, for agents that inherit the calling
 /// thread's CPUs (the launcher's or the host's, like the world's); `None` when they cannot be read.
 pub(crate) fn chain_cpus(chains: usize) -> Option<Vec<usize>> {
-    let allowed = allowed_cpus().ok().filter(|allowed| !allowed.is_empty())?;
+    let allowed = allowed_cpus().ok()?;
     Some(
         (0..chains)
             .map(|chain| chain_cpu(chain, &allowed))
@@ -51,18 +48,22 @@ pub(crate) fn current_cpu() -> Option<usize> {
     usize::try_from(unsafe { libc::sched_getcpu() }).ok()
 }
 
-/// The CPUs the calling thread may run on, ascending.
+/// The CPUs the calling thread may run on, ascending; never empty.
 fn allowed_cpus() -> io::Result<Vec<usize>> {
     // SAFETY: a zeroed cpu_set_t is a valid empty set; sched_getaffinity fills it and CPU_ISSET only reads it.
-    unsafe {
+    let allowed: Vec<usize> = unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
         if libc::sched_getaffinity(0, size_of::<libc::cpu_set_t>(), &mut set) != 0 {
             return Err(io::Error::last_os_error());
         }
-        Ok((0..libc::CPU_SETSIZE as usize)
+        (0..libc::CPU_SETSIZE as usize)
             .filter(|&cpu| libc::CPU_ISSET(cpu, &set))
-            .collect())
+            .collect()
+    };
+    if allowed.is_empty() {
+        return Err(io::Error::other("no CPU is allowed"));
     }
+    Ok(allowed)
 }
 
 #[cfg(test)]

@@ -375,20 +375,23 @@ impl WorldLink {
         };
         let on_this_cpu =
             |chain: usize| here.is_some() && self.chain_cpus.get(chain).copied() == here;
-        for this_cpus_pass in [false, true] {
-            for (index, chain) in sync.chains().enumerate() {
-                if on_this_cpu(index) != this_cpus_pass {
-                    continue;
-                }
-                let robots = chain.start as usize..chain.end as usize;
-                let frames = &mut self.frames[robots.clone()];
-                SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
-                for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
-                    entry.update_with_copy(*frame);
-                }
-                if !this_cpus_pass {
-                    sync.start_chain(chain.start, tick);
-                }
+        let elsewhere = sync
+            .chains()
+            .enumerate()
+            .filter(|&(index, _)| !on_this_cpu(index));
+        let here_last = sync
+            .chains()
+            .enumerate()
+            .filter(|&(index, _)| on_this_cpu(index));
+        for (index, chain) in elsewhere.chain(here_last) {
+            let robots = chain.start as usize..chain.end as usize;
+            let frames = &mut self.frames[robots.clone()];
+            SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
+            for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
+                entry.update_with_copy(*frame);
+            }
+            if !on_this_cpu(index) {
+                sync.start_chain(chain.start, tick);
             }
         }
         for (index, chain) in sync.chains().enumerate() {

@@ -1,5 +1,6 @@
-//! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>`, `<experiment length ticks_per_second random_seed>`
-//! and `<hosts>` (checked here, read by [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
+//! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>`,
+//! `<experiment length ticks_per_second random_seed>` and `<hosts>` (checked here, read by
+//! [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
 
 use super::Ctx;
 use crate::config::model::{Element, Framework, Location};

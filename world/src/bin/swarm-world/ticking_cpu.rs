@@ -24,8 +24,7 @@ impl TickingCpu {
         let Link::Local(local) = link else {
             return None;
         };
-        let mut agents = local.agent_pids();
-        agents.sort_unstable();
+        let agents = local.agent_pids();
         Some(TickingCpu {
             agents_mark: CpuMark::take_of(agents.iter().copied()),
             world_mark: CpuMark::take_of([std::process::id()]),
@@ -40,11 +39,7 @@ impl TickingCpu {
         let ticks = link.tick().saturating_sub(self.first_tick) as f64;
         let world = self.world_mark.per_step_of([std::process::id()], ticks);
         let same_agents = match link {
-            Link::Local(local) => {
-                let mut now = local.agent_pids();
-                now.sort_unstable();
-                now == self.agents
-            }
+            Link::Local(local) => local.agent_pids() == self.agents,
             Link::Remote(_) => false,
         };
         let agents = same_agents.then(|| {
