@@ -8,7 +8,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use robot_agent::control::{self, Control};
 use robot_agent::controller::{self, Plan};
 use robot_agent::params::Params;
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 fn frames() -> [SensorFrame; 2] {
     let clear = SensorFrame::empty(0);

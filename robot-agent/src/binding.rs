@@ -7,9 +7,9 @@
 
 use std::fmt;
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
-use swarm_runtime::player::EventCallbacks;
-use swarm_runtime::supervisor_gen::compiled::CompiledEvent;
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::player::EventCallbacks;
+use swarm_contract::supervisor_gen::compiled::CompiledEvent;
 use thiserror::Error;
 
 use crate::profile::{Procedure, Profile};

@@ -4,9 +4,9 @@
 //! the profile's callbacks (one error listing all mismatches), or builds the native controller. Every failure here
 //! happens at startup, so the agent can exit non-zero with the reason before tick 1.
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
-use swarm_runtime::player::{Player, PlayerError};
-use swarm_runtime::supervisor_gen::compiled::SupervisorSet;
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::player::{Player, PlayerError};
+use swarm_contract::supervisor_gen::compiled::SupervisorSet;
 use thiserror::Error;
 use tracing::info;
 

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use swarm_runtime::config::{Controller, Diagnostic, Experiment, Location};
+use swarm_contract::config::{Controller, Diagnostic, Experiment, Location};
 
 use crate::control::{self, Control};
 use crate::controller::{self, Plan, Supervisors};

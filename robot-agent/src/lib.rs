@@ -2,7 +2,7 @@
 //! profile, or a native controller), binds every supervisor event to its callback by name, and runs one control
 //! step per tick.
 //!
-//! It sees only `swarm_runtime`: the sensor frame, the actuator command, the player and the transport. It never
+//! It sees only `swarm_contract`: the sensor frame, the actuator command, the player and the transport. It never
 //! depends on the world.
 
 pub mod binding;

@@ -17,59 +17,33 @@ use robot_agent::controller::{self, Plan};
 use robot_agent::from_config;
 use robot_agent::params::Params;
 use robot_agent::resume::Resumer;
-use swarm_runtime::config::Experiment;
-use swarm_runtime::launcher::resume::ResumePoint;
-use swarm_runtime::messages::ActuatorCommand;
-use swarm_runtime::transport::{AgentLink, RunSpec, TransportError};
+use swarm_contract::config::Experiment;
+use swarm_contract::messages::ActuatorCommand;
+use swarm_contract::protocol::launcher_to_agent::AgentArgs;
+use swarm_contract::protocol::resume::ResumePoint;
+use swarm_contract::transport::{AgentLink, RunSpec, TransportError};
 use tracing::{debug, info};
 
 /// One robot of a swarm run.
 #[derive(Debug, Parser)]
 #[command(name = "robot-agent", version)]
 struct Args {
-    /// Run name (shared by every process of the run).
-    #[arg(long)]
-    run: String,
-    /// Absolute iceoryx2 root directory of the run.
-    #[arg(long = "iox-root", required_unless_present = "check")]
-    iox_root: Option<PathBuf>,
-    /// Index of this robot in the run (0..N).
-    #[arg(long)]
-    robot: u32,
-    /// Slot of the robot in the local transport when it differs from --robot: a `swarm host` numbers its share
-    /// 0..k locally, while --robot stays the run-wide id that seeds the random stream and picks the controller.
-    #[arg(long)]
-    slot: Option<u32>,
-    /// Run seed; the player's random stream is derived from it and the robot index. Default: the
-    /// configuration's `random_seed`, or 0 without --config.
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Experiment configuration (.argos); the robot runs the controller its `<e-puck>` names.
-    #[arg(long, conflicts_with_all = ["element", "profile", "supervisors", "params"])]
-    config: Option<PathBuf>,
-    /// With --config: id of the robot's controller in `<controllers>` (default: the one its `<e-puck>` names).
-    #[arg(long, requires = "config")]
-    controller: Option<String>,
+    /// Which robot of which run: the flags the launcher and `swarm host` pass.
+    #[command(flatten)]
+    agent: AgentArgs,
     /// Without --config: controller element name, as a `<controllers>` child would be named.
-    #[arg(long, default_value = "")]
+    #[arg(long, default_value = "", conflicts_with = "config")]
     element: String,
     /// Without --config: operational-procedure profile (with --supervisors).
-    #[arg(long, requires = "supervisors")]
+    #[arg(long, requires = "supervisors", conflicts_with = "config")]
     profile: Option<String>,
     /// Without --config: comma-separated XML model files, one folder of them, or one compiled supervisor-set file
     /// (with --profile), relative to the working directory.
-    #[arg(long, requires = "profile")]
+    #[arg(long, requires = "profile", conflicts_with = "config")]
     supervisors: Option<String>,
     /// Without --config: controller parameter, as an attribute of <params> (repeatable), e.g. --param velocity=5.
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param, conflicts_with = "config")]
     params: Vec<(String, String)>,
-    /// Number of robots of the run, when `swarm run --robots` changed the configuration's count (with --config).
-    #[arg(long, requires = "config")]
-    robots: Option<u32>,
-    /// With --config: load this compiled supervisor-set file instead of the supervisors the controller's
-    /// parameters name (the launcher compiles each controller's models once per run).
-    #[arg(long = "compiled-supervisors", requires = "config")]
-    compiled_supervisors: Option<PathBuf>,
     /// Load, synthesise and bind the controller, print its event names by id as a JSON array on standard output,
     /// then exit without joining the run.
     #[arg(long)]
@@ -78,9 +52,6 @@ struct Args {
     /// controller).
     #[arg(long = "write-supervisors", requires = "check")]
     write_supervisors: Option<PathBuf>,
-    /// Resume point of a restarted robot (written by the world): the supervisors continue from it.
-    #[arg(long)]
-    resume: Option<PathBuf>,
 }
 
 fn parse_param(s: &str) -> Result<(String, String), String> {
@@ -92,10 +63,10 @@ fn parse_param(s: &str) -> Result<(String, String), String> {
 
 /// Plans and builds the robot's controller from the configuration or from the manual flags.
 fn build_control(args: &Args) -> Result<(Plan, Control)> {
-    if let Some(path) = &args.config {
+    if let Some(path) = &args.agent.config {
         let (experiment, warnings) =
             Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
-        let experiment = match args.robots {
+        let experiment = match args.agent.robots {
             Some(robots) => experiment
                 .with_robot_count(robots)
                 .map_err(|errors| anyhow!("{errors}"))?,
@@ -104,23 +75,23 @@ fn build_control(args: &Args) -> Result<(Plan, Control)> {
         for w in &warnings {
             debug!("{w}");
         }
-        let seed = match (args.seed, experiment.framework.random_seed) {
+        let seed = match (args.agent.seed, experiment.framework.random_seed) {
             (Some(seed), _) | (None, Some(seed)) => seed,
             (None, None) => anyhow::bail!(
                 "{}: random_seed is left to the clock; pass the run's seed with --seed",
                 path.display()
             ),
         };
-        let controller = match &args.controller {
+        let controller = match &args.agent.controller {
             Some(id) => from_config::controller_by_id(&experiment, id)?,
-            None => from_config::controller_of(&experiment, args.robot)?,
+            None => from_config::controller_of(&experiment, args.agent.robot)?,
         };
         let (plan, control) = from_config::build(
             &experiment,
             controller,
             seed,
-            args.robot,
-            args.compiled_supervisors.as_deref(),
+            args.agent.robot,
+            args.agent.compiled_supervisors.as_deref(),
         )?;
         info!(
             controller = controller.id.as_str(),
@@ -136,8 +107,8 @@ fn build_control(args: &Args) -> Result<(Plan, Control)> {
     let params = Params::new(pairs);
     let base_dir = std::env::current_dir().context("cannot resolve relative paths")?;
     let plan = controller::plan(&args.element, &params, &base_dir)?;
-    let seed = args.seed.unwrap_or(0);
-    let control = control::build(&plan, &params, seed, args.robot)?;
+    let seed = args.agent.seed.unwrap_or(0);
+    let control = control::build(&plan, &params, seed, args.agent.robot)?;
     info!(seed, "robot runs {plan}");
     Ok((plan, control))
 }
@@ -183,21 +154,21 @@ fn limit_reached(error: &TransportError) -> bool {
 
 /// Answers every tick of the run until the world ends it.
 fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<()> {
-    let point = match &args.resume {
+    let point = match &args.agent.resume {
         Some(path) => Some(ResumePoint::read(path)?),
         None => None,
     };
     let mut resumer = Resumer::new(point);
-    let run = RunSpec::new(&args.run, root)?;
-    let slot = args.slot.unwrap_or(args.robot);
+    let run = RunSpec::new(&args.agent.run, root)?;
+    let slot = args.agent.slot.unwrap_or(args.agent.robot);
     let mut link = join(&run, slot)?;
     info!(
-        run = args.run.as_str(),
-        robot = args.robot,
+        run = args.agent.run.as_str(),
+        robot = args.agent.robot,
         slot,
         "joined the run"
     );
-    tick_loop(&mut link, control, &mut resumer, args.robot)
+    tick_loop(&mut link, control, &mut resumer, args.agent.robot)
 }
 
 /// The agent's tick loop: step the controller on each tick's frame and answer, until the world ends the run or
@@ -252,23 +223,26 @@ fn install_stop_handler() -> Result<()> {
 }
 
 fn run(args: &Args) -> Result<()> {
+    if args.agent.iox_root.is_none() && !args.check {
+        anyhow::bail!("--iox-root is required to join a run (only --check works without it)");
+    }
     let (plan, mut control) = build_control(args)
-        .with_context(|| format!("robot {}: cannot start its controller", args.robot))?;
-    let Some(root) = args.iox_root.as_deref().filter(|_| !args.check) else {
+        .with_context(|| format!("robot {}: cannot start its controller", args.agent.robot))?;
+    let Some(root) = args.agent.iox_root.as_deref().filter(|_| !args.check) else {
         if let Some(path) = &args.write_supervisors {
             write_supervisors(&plan, path)?;
         }
-        info!(robot = args.robot, "controller checked");
+        info!(robot = args.agent.robot, "controller checked");
         println!("{}", serde_json::to_string(&control.event_names())?);
         return Ok(());
     };
     install_stop_handler()?;
     serve(args, root, &mut control)
-        .with_context(|| format!("robot {} in run {}", args.robot, args.run))
+        .with_context(|| format!("robot {} in run {}", args.agent.robot, args.agent.run))
 }
 
 fn main() -> ExitCode {
-    swarm_runtime::logging::init("info,supervisor_gen=warn");
+    swarm_contract::logging::init("info,supervisor_gen=warn");
     match run(&Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

@@ -1,11 +1,11 @@
-//! What an operational-procedure profile is (ptsct.md 8.1, layer 3): per-robot memory plus one callback per event.
+//! What an operational-procedure profile is (docs/ptsct.md 8.1, layer 3): per-robot memory plus one callback per event.
 //!
 //! A profile is a type holding one robot's memory and parameters; its [`Profile::PROCEDURES`] table maps the event
 //! names the models use to plain function pointers. Controllable events get an action on the
-//! [`ActuatorCommand`]; uncontrollable events get a pure check of the [`SensorFrame`] (ptsct.md 8.2). A profile
+//! [`ActuatorCommand`]; uncontrollable events get a pure check of the [`SensorFrame`] (docs/ptsct.md 8.2). A profile
 //! never sees the world or the supervisors: only the frame of the current tick and its own memory.
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 use crate::params::{ParamError, Params};
 

@@ -9,9 +9,9 @@
 //! Timers keep counting through the gap: a supervisor's clock is the world's. Native controllers keep their own
 //! state and have nothing to restore.
 
-use swarm_runtime::launcher::resume::ResumePoint;
-use swarm_runtime::messages::{SensorFrame, SupervisorSnapshot};
-use swarm_runtime::player::PlayerError;
+use swarm_contract::messages::{SensorFrame, SupervisorSnapshot};
+use swarm_contract::player::PlayerError;
+use swarm_contract::protocol::resume::ResumePoint;
 use tracing::info;
 
 use crate::control::Control;

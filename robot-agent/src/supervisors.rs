@@ -8,13 +8,13 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use swarm_runtime::supervisor_gen::architecture::Architecture;
-use swarm_runtime::supervisor_gen::compiled::{CodegenError, CompiledFormatError, SupervisorSet};
-use swarm_runtime::supervisor_gen::convert::{ConvertError, to_project};
-use swarm_runtime::supervisor_gen::diagnostics::{Diagnostic, has_errors};
-use swarm_runtime::supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
-use swarm_runtime::supervisor_gen::validate::{ValidateOptions, validate};
-use swarm_runtime::supervisor_gen::xml_read::read_model;
+use swarm_contract::supervisor_gen::architecture::Architecture;
+use swarm_contract::supervisor_gen::compiled::{CodegenError, CompiledFormatError, SupervisorSet};
+use swarm_contract::supervisor_gen::convert::{ConvertError, to_project};
+use swarm_contract::supervisor_gen::diagnostics::{Diagnostic, has_errors};
+use swarm_contract::supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
+use swarm_contract::supervisor_gen::validate::{ValidateOptions, validate};
+use swarm_contract::supervisor_gen::xml_read::read_model;
 use thiserror::Error;
 use tracing::warn;
 

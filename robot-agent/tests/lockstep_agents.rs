@@ -4,8 +4,8 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use swarm_runtime::messages::SensorFrame;
-use swarm_runtime::transport::{LinkConfig, RunSpec, WorldLink};
+use swarm_contract::messages::SensorFrame;
+use swarm_contract::transport::{LinkConfig, RunSpec, WorldLink};
 
 const AGENT: &str = env!("CARGO_BIN_EXE_robot-agent");
 /// Generous: agents of a loaded machine may take seconds to start.

@@ -1,14 +1,14 @@
 //! The shipped obstacle-avoidance models synthesise local-modular, pass the local-modular validation
-//! (ptsct.md 6.6) and bind to their profiles.
+//! (docs/ptsct.md 6.6) and bind to their profiles.
 
 use std::path::{Path, PathBuf};
 
 use robot_agent::params::Params;
 use robot_agent::profiles::bind_profile;
-use swarm_runtime::supervisor_gen::architecture::Architecture;
-use swarm_runtime::supervisor_gen::load::{Input, load};
-use swarm_runtime::supervisor_gen::pipeline::{Synthesis, SynthesisOptions, synthesize};
-use swarm_runtime::supervisor_gen::validate::ValidateOptions;
+use swarm_contract::supervisor_gen::architecture::Architecture;
+use swarm_contract::supervisor_gen::load::{Input, load};
+use swarm_contract::supervisor_gen::pipeline::{Synthesis, SynthesisOptions, synthesize};
+use swarm_contract::supervisor_gen::validate::ValidateOptions;
 
 fn models(variant: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -29,7 +29,7 @@ fn synthesise(variant: &str, files: &[&str]) -> Synthesis {
         .collect();
     assert!(errors.is_empty(), "{errors:#?}");
     let project =
-        swarm_runtime::supervisor_gen::convert::to_project(&validation.models.unwrap()).unwrap();
+        swarm_contract::supervisor_gen::convert::to_project(&validation.models.unwrap()).unwrap();
     synthesize(
         &project,
         Architecture::LocalModular,
@@ -171,7 +171,7 @@ fn ptsct_supervisors_have_two_states_each_and_memcons_107_bytes() {
             sup.name
         );
     }
-    // s = 4, t = 12, t_c = 10, e = 5, N = 2: (4 + 36) + 2 (4 + 20) + 5 + 7 * 2 (ptsct.md section 9).
+    // s = 4, t = 12, t_c = 10, e = 5, N = 2: (4 + 36) + 2 (4 + 20) + 5 + 7 * 2 (docs/ptsct.md section 9).
     assert_eq!(s.compile().unwrap().mem_cons(), 107);
 }
 
@@ -200,8 +200,8 @@ fn sct_walk_supervisor_grows_to_six_states_and_memcons_189_bytes() {
 #[test]
 fn compiled_file_written_by_the_toolchain_loads_as_the_same_set_as_the_model_folder() {
     let m = |f: &str| models("ptsct").join(f);
-    let built = swarm_runtime::supervisor_gen::build::build(
-        &swarm_runtime::supervisor_gen::build::BuildRequest {
+    let built = swarm_contract::supervisor_gen::build::build(
+        &swarm_contract::supervisor_gen::build::BuildRequest {
             plants: vec![m("G_prox.xml"), m("G_motor.xml")],
             specs: vec![m("E_walk.xml"), m("E_avoid.xml")],
             architecture: Architecture::LocalModular,

@@ -5,9 +5,9 @@ use std::path::Path;
 use robot_agent::params::Params;
 use robot_agent::profiles::{BoxedCallbacks, bind_profile};
 use robot_agent::supervisors::{self, OBSTACLE_AVOIDANCE_PTSCT};
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
-use swarm_runtime::player::Player;
-use swarm_runtime::supervisor_gen::compiled::SupervisorSet;
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::player::Player;
+use swarm_contract::supervisor_gen::compiled::SupervisorSet;
 
 struct Robot {
     names: Vec<String>,

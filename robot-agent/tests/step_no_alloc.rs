@@ -6,8 +6,8 @@ use std::path::Path;
 use robot_agent::control;
 use robot_agent::controller;
 use robot_agent::params::Params;
-use swarm_runtime::alloc_count::{CountingAllocator, thread_allocations};
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::alloc_count::{CountingAllocator, thread_allocations};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;

@@ -1,4 +1,4 @@
-//! Located diagnostics: the error and warning codes of ptsct.md section 11, plus the two document-level codes
+//! Located diagnostics: the error and warning codes of docs/ptsct.md section 11, plus the two document-level codes
 //! (`X1` malformed XML, `X2` not a model document), and the byte-offset to line:column mapping they rely on.
 //!
 //! Every problem found in a user's file is one [`Diagnostic`] that names the file, the 1-based line and column, the
@@ -19,7 +19,7 @@ pub enum Severity {
 }
 
 /// The code of a diagnostic: `X1`/`X2` for documents that are not models at all, `V1`-`V15` and `W1`-`W6` exactly as
-/// in ptsct.md section 11.
+/// in docs/ptsct.md section 11.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 pub enum Code {
     /// The file is not well-formed XML (unclosed tag, bad quoting, mismatched end tag, ...).

@@ -1,4 +1,4 @@
-//! Graphviz drawings of models, products and supervisors with the conventions of ptsct.md section 1: controllable
+//! Graphviz drawings of models, products and supervisors with the conventions of docs/ptsct.md section 1: controllable
 //! arcs single black lines, uncontrollable arcs red double lines, marked states double circles, an entry arrow on the
 //! initial state, bad states filled red and otherwise removed states outlined in dashed red. Controllable labels show
 //! P (when not 1) and T (when not 0).

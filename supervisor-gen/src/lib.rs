@@ -3,7 +3,7 @@
 //! Reads plant and specification automata (the thesis XML format, or Nadzoru2 FSA files), validates them with
 //! located errors, synthesises supervisors (monolithic, modular, local-modular), checks and minimises them, draws
 //! them, reports their memory and compiles them into the byte layout the robot agents execute.
-//! `shared/reference/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
+//! `docs/ptsct.md` is the normative specification; section numbers in doc comments refer to it.
 //!
 //! This crate depends on nothing else of the workspace.
 

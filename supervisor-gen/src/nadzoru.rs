@@ -1,4 +1,4 @@
-//! Importer for Nadzoru2 FSA files (ptsct.md section 13): `<model type="FSA"><data>` with states, events and
+//! Importer for Nadzoru2 FSA files (docs/ptsct.md section 13): `<model type="FSA"><data>` with states, events and
 //! transitions referring to each other by numeric id.
 //!
 //! Ids are resolved to names here; `x`, `y`, `observable` and any other layout attributes are ignored. The format has

@@ -1,4 +1,4 @@
-//! `report.json`: the designer-facing summary of one synthesis run (ptsct.md section 12, step 9).
+//! `report.json`: the designer-facing summary of one synthesis run (docs/ptsct.md section 12, step 9).
 //!
 //! Per supervisor: size, events, every state SupC removed and why; the whole set's MemCons by the section 9 formula
 //! and the bytes actually written; the architecture checks; every validation warning. The report mirrors the

@@ -1,5 +1,5 @@
 //! Located, not yet validated model declarations: what a model file says, with the position of every element and
-//! attribute, before any rule of ptsct.md section 11 is applied.
+//! attribute, before any rule of docs/ptsct.md section 11 is applied.
 //!
 //! Both readers (the thesis format in `xml_read` and the Nadzoru2 importer in `nadzoru`) produce a [`SourceModel`];
 //! `validate` checks it and turns it into typed models. Nothing here interprets weights, times or reachability.
@@ -30,9 +30,9 @@ pub fn parse_kind(value: &str) -> Option<ModelKind> {
 /// Which file format a model was read from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SourceFormat {
-    /// The thesis format of ptsct.md section 10 (`<automata>`).
+    /// The thesis format of docs/ptsct.md section 10 (`<automata>`).
     Thesis,
-    /// A Nadzoru2 FSA file (ptsct.md section 13), whose type comes from how it was passed.
+    /// A Nadzoru2 FSA file (docs/ptsct.md section 13), whose type comes from how it was passed.
     Nadzoru,
 }
 

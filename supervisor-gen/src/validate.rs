@@ -1,4 +1,4 @@
-//! Structural validation of ptsct.md section 11: the per-file rules V1-V9, V11, V12, V14, V15 and W1-W4, and the
+//! Structural validation of docs/ptsct.md section 11: the per-file rules V1-V9, V11, V12, V14, V15 and W1-W4, and the
 //! project rules V10, V13, V15 (event count), W5 and W6. Supervisor files (tool output read back) are exempt from
 //! V6 and V7.
 //!

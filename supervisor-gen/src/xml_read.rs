@@ -1,5 +1,5 @@
-//! Reader for model files: the thesis XML format (ptsct.md section 10) and, by its root element, Nadzoru2 FSA files
-//! (section 13, see `nadzoru`).
+//! Reader for model files: the thesis XML format (docs/ptsct.md section 10) and, by its root element, Nadzoru2
+//! FSA files (section 13, see `nadzoru`).
 //!
 //! The reader only checks the document shape (codes `X1`, `X2`): known elements and attributes, required
 //! attributes, flag values. Children may come in any order. Every rule about the model itself is left to `validate`.

@@ -1,4 +1,4 @@
-//! Writer for the thesis XML format (ptsct.md section 10.4): children in DTD order (states, events, transitions),
+//! Writer for the thesis XML format (docs/ptsct.md section 10.4): children in DTD order (states, events, transitions),
 //! canonical `1`/`0` flags, explicit `prob` and `time` on every controllable transition and neither on uncontrollable
 //! ones. Probabilities are written with the shortest text that reads back to the same `f64`, so reading a written
 //! file gives the same automaton.

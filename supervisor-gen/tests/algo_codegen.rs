@@ -40,7 +40,7 @@ fn worked_example() -> SupervisorSet {
 fn checked_in_generated_module_is_current() {
     let src = generate_rust(
         &worked_example(),
-        "the worked example of ptsct.md section 9",
+        "the worked example of docs/ptsct.md section 9",
     );
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(GOLDEN);
     if std::env::var_os("SUPERVISOR_GEN_BLESS").is_some() {

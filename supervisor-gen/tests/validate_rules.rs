@@ -1,4 +1,4 @@
-//! Every structural rule of ptsct.md section 11 (and the document codes X1/X2) on a malformed fixture, with the
+//! Every structural rule of docs/ptsct.md section 11 (and the document codes X1/X2) on a malformed fixture, with the
 //! exact located message it must produce. Each test validates its files as one project and compares the complete
 //! list of diagnostics, so an extra or missing report fails too.
 

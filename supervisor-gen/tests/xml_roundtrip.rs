@@ -1,4 +1,4 @@
-//! The reader and writer of the thesis XML format (ptsct.md section 10): the section 10.3 worked example parses
+//! The reader and writer of the thesis XML format (docs/ptsct.md section 10): the section 10.3 worked example parses
 //! with its defaults, and what the writer produces reads back to the same automaton.
 
 use std::path::PathBuf;

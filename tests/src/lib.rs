@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
-use swarm_runtime::transport::RUN_ROOTS_DIR;
+use swarm_contract::transport::RUN_ROOTS_DIR;
 
 /// The folder holding `swarm`, `swarm-world` and `robot-agent`, brought up to date once per test binary with the
 /// cargo that runs the tests. It asks for exactly the build of the README's test command (`cargo test --workspace`,

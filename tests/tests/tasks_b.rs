@@ -1,4 +1,4 @@
-//! Foraging and pheromone foraging (tasks.md 4 and 5): the shipped models pass the local-modular architecture
+//! Foraging and pheromone foraging (docs/tasks.md 4 and 5): the shipped models pass the local-modular architecture
 //! check, competing events keep their stated ratios at runtime, and a short foraging run through `swarm run`
 //! delivers a target that shows up in `summary.json`.
 
@@ -75,7 +75,7 @@ fn owners(built: &Built, event: &str) -> Vec<String> {
         .collect()
 }
 
-/// ptsct.md 5.2: the runtime weight of an event is the product of its owners' factors, so events that compete in
+/// docs/ptsct.md 5.2: the runtime weight of an event is the product of its owners' factors, so events that compete in
 /// one choice (E5's walk 9/1/1, E2's 20/80 and 8/1/1, E4's rest-ended against rest-wait, E7's 20/80 rest
 /// decision, the pheromone follow events' weight 6) keep the ratio the module states only when every other owner
 /// scales them alike: they must have the same owners.

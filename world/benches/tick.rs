@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::Rng;
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::devices::Devices;
 use swarm_world::geometry::{Placed, Shape, Vec2};
 use swarm_world::in_process::avoid_obstacles;

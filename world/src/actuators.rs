@@ -3,14 +3,14 @@
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use swarm_runtime::messages::{ActuatorCommand, GripperAction, PHEROMONE_CHANNELS};
+use swarm_contract::messages::{ActuatorCommand, GripperAction, PHEROMONE_CHANNELS};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{ROBOT_RADIUS, RobotId, TargetId, TargetState};
 use crate::geometry::unit;
 use crate::media::rab::RabMedium;
 
-/// Wheel speed limit in cm/s (the real e-puck's, epuck-and-world.md 1.1).
+/// Wheel speed limit in cm/s (the real e-puck's, docs/epuck-and-world.md 1.1).
 pub const MAX_WHEEL_SPEED_CM_S: f32 = 12.8;
 /// Distance between the wheels in metres.
 pub const INTER_WHEEL_DISTANCE: f32 = 0.053;

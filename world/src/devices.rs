@@ -8,7 +8,7 @@ use crate::actuators::GRIPPER_REACH;
 /// Options of the `epuck_proximity` sensor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProximityOptions {
-    /// Additive uniform noise bound `noise_level` (epuck-and-world.md section 2).
+    /// Additive uniform noise bound `noise_level` (docs/epuck-and-world.md section 2).
     pub noise_level: f32,
     /// Additive Gaussian noise standard deviation `noise_std_dev` (the aggregation sanity test).
     pub noise_std_dev: f32,

@@ -1,4 +1,4 @@
-//! `<distribute>` exactly as ARGoS does it (epuck-and-world.md 4.4): ids are the base id followed by the index
+//! `<distribute>` exactly as ARGoS does it (docs/epuck-and-world.md 4.4): ids are the base id followed by the index
 //! (from `base_num`, no separator); each entity's pose is drawn from the position and orientation generators and
 //! redrawn while its body collides with anything placed before it, at most `max_trials` times; bodiless entities
 //! are never checked; a grid takes the lattice points in order and fails on a collision.
@@ -8,7 +8,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use swarm_runtime::config::{Distribute, Entity, Euler, OrientationMethod, PositionMethod, Vec3};
+use swarm_contract::config::{Distribute, Entity, Euler, OrientationMethod, PositionMethod, Vec3};
 
 use crate::entities::ROBOT_RADIUS;
 use crate::error::WorldError;

@@ -4,14 +4,14 @@
 //! that leave the arena change state instead of disappearing, so handles stay valid for the whole run). Systems
 //! (sensors, actuators, media, loop functions) are functions over these sets; no entity points at another.
 
-use swarm_runtime::messages::Rgb;
+use swarm_contract::messages::Rgb;
 
 use crate::devices::Devices;
 use crate::geometry::{Placed, Shape, Vec2};
 use crate::physics::{BodyHandles, Motion};
 use crate::rng::RobotStreams;
 
-/// e-puck body radius in metres (epuck-and-world.md 1.1).
+/// e-puck body radius in metres (docs/epuck-and-world.md 1.1).
 pub const ROBOT_RADIUS: f32 = 0.035;
 /// e-puck body height in metres (IRIDIA model); bodies this tall occlude what passes below their top.
 pub const ROBOT_HEIGHT: f32 = 0.076;

@@ -5,10 +5,10 @@
 //! `<leds>`, in which case they are targets (ARGoS' passive objects with an LED; one LED each); `<target>` is a
 //! target; `<e-puck>` a robot; `<light>` a light. Every failure is a [`WorldError`] naming `file:line:column`.
 
-use swarm_runtime::config::{
+use swarm_contract::config::{
     self, Controller, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
-use swarm_runtime::messages::{PHEROMONE_CHANNELS, RAB_PAYLOAD_BYTES, Rgb};
+use swarm_contract::messages::{PHEROMONE_CHANNELS, RAB_PAYLOAD_BYTES, Rgb};
 
 use crate::actuators::GRIPPER_REACH;
 use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions};

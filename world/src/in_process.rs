@@ -4,11 +4,11 @@
 //! recommended theta_obs), pivot away from the side with the higher readings. Real robots run supervisors in
 //! their own processes; this exists so the world can be exercised and measured alone.
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 use crate::actuators::MAX_WHEEL_SPEED_CM_S;
 
-/// Front-sensor reading above which the robot turns (tasks.md 3, theta_obs).
+/// Front-sensor reading above which the robot turns (docs/tasks.md 3, theta_obs).
 pub const OBSTACLE_THRESHOLD: f32 = 0.1;
 
 /// The obstacle-avoidance rule: sets the wheels from the proximity readings.

@@ -6,9 +6,9 @@
 //! [`World::act_and_step`] only reuses buffers around the rapier2d step (which allocates a few small buffers of its
 //! own per step).
 
-use swarm_runtime::config::Experiment;
-use swarm_runtime::config::faults::DeadBodies;
-use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
+use swarm_contract::config::Experiment;
+use swarm_contract::config::faults::DeadBodies;
+use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use crate::actuators;
 use crate::arena::Arena;
@@ -30,7 +30,7 @@ use crate::sensors::{Observer, camera, ground, light, proximity, rab};
 
 /// Default range of a robot's range-and-bearing emitter in metres.
 pub const DEFAULT_RAB_RANGE: f32 = 0.8;
-/// Default pheromone cell side in metres (tasks.md 5.2).
+/// Default pheromone cell side in metres (docs/tasks.md 5.2).
 pub const DEFAULT_PHEROMONE_CELL: f32 = 0.05;
 
 /// Tags in physics user data: the kind in the high word, the index in the low word.
@@ -95,7 +95,7 @@ impl WorldBuilder {
             handles,
             position,
             heading,
-            led: swarm_runtime::messages::Rgb::OFF,
+            led: swarm_contract::messages::Rgb::OFF,
             alive: true,
             removed: false,
             wheels: [0.0; 2],
@@ -149,7 +149,7 @@ impl WorldBuilder {
         name: &str,
         placed: Placed,
         height: f32,
-        led: swarm_runtime::messages::Rgb,
+        led: swarm_contract::messages::Rgb,
         led_height: f32,
     ) -> TargetId {
         let id = TargetId(self.arena.targets.len() as u32);
@@ -292,7 +292,7 @@ impl World {
         };
         r.alive = alive;
         if !alive {
-            r.led = swarm_runtime::messages::Rgb::OFF;
+            r.led = swarm_contract::messages::Rgb::OFF;
             r.wheels = [0.0; 2];
             self.arena.physics.drive(r.handles.body, 0.0, 0.0);
         }

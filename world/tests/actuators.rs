@@ -3,8 +3,8 @@
 mod common;
 
 use common::{TPS, builder, drive, frames, wall, wheels};
-use swarm_runtime::config::faults::DeadBodies;
-use swarm_runtime::messages::{ActuatorCommand, GripperAction, Rgb};
+use swarm_contract::config::faults::DeadBodies;
+use swarm_contract::messages::{ActuatorCommand, GripperAction, Rgb};
 use swarm_world::arena::GripperEvent;
 use swarm_world::devices::Devices;
 use swarm_world::entities::{ROBOT_RADIUS, RobotId, TargetState};

@@ -3,8 +3,8 @@
 mod common;
 
 use common::config::{at, epuck, thesis_example, uniform};
-use swarm_runtime::config::{Element, Entity, LightEntity, LoopFunctions, PositionMethod, Vec3};
-use swarm_runtime::messages::Rgb;
+use swarm_contract::config::{Element, Entity, LightEntity, LoopFunctions, PositionMethod, Vec3};
+use swarm_contract::messages::Rgb;
 use swarm_world::entities::ROBOT_RADIUS;
 use swarm_world::geometry::{Placed, Shape};
 use swarm_world::{World, WorldError};

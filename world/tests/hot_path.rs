@@ -1,13 +1,13 @@
 //! The world's own hot path allocates nothing: once warmed up, `sense` makes no heap allocation at all. (The
 //! rapier2d step inside `act_and_step` allocates about ten small buffers per tick internally; everything of ours
-//! around it reuses preallocated buffers.) Counted with swarm_runtime's counting global allocator (this thread only); this file is its own test
+//! around it reuses preallocated buffers.) Counted with swarm_contract's counting global allocator (this thread only); this file is its own test
 //! binary, so the allocator affects nothing else.
 
 mod common;
 
 use common::config::thesis_example;
-use swarm_runtime::alloc_count::{CountingAllocator, thread_allocations};
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::alloc_count::{CountingAllocator, thread_allocations};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::World;
 use swarm_world::in_process::avoid_obstacles;
 

@@ -4,7 +4,7 @@ mod common;
 
 use common::config::thesis_example;
 use common::{builder, drive, wall, wheels};
-use swarm_runtime::config::{Element, LoopFunctions};
+use swarm_contract::config::{Element, LoopFunctions};
 use swarm_world::devices::Devices;
 use swarm_world::geometry::Vec2;
 use swarm_world::in_process::avoid_obstacles;

@@ -1,9 +1,9 @@
-//! Sensor models against analytic geometry, with the numbers of epuck-and-world.md section 1.
+//! Sensor models against analytic geometry, with the numbers of docs/epuck-and-world.md section 1.
 
 mod common;
 
 use common::{builder, frames, wall};
-use swarm_runtime::messages::Rgb;
+use swarm_contract::messages::Rgb;
 use swarm_world::devices::{Devices, ProximityOptions};
 use swarm_world::entities::{FloorRegion, Light, ROBOT_RADIUS};
 use swarm_world::geometry::{Placed, Shape, Vec2};
@@ -266,7 +266,7 @@ fn camera_sees_leds_within_35_cm_nearest_first_and_not_its_own() {
     food(&mut b, Vec2::new(0.3, 0.0));
     food(&mut b, Vec2::new(0.4, 0.0));
     let mut world = b.build();
-    let mut cmds = vec![swarm_runtime::messages::ActuatorCommand::idle(0, 1); 2];
+    let mut cmds = vec![swarm_contract::messages::ActuatorCommand::idle(0, 1); 2];
     cmds[0].led = Rgb { r: 0, g: 0, b: 255 };
     cmds[1].led = GREEN;
     cmds[1].robot = 1;
@@ -305,7 +305,7 @@ fn rab_reports_range_minus_two_radii_and_bearing_in_the_receiver_frame() {
     );
     b.robot("far", "c", Vec2::new(-0.9, 0.0), 0.0, Devices::ALL);
     let mut world = b.build();
-    let mut cmds = vec![swarm_runtime::messages::ActuatorCommand::idle(0, 1); 3];
+    let mut cmds = vec![swarm_contract::messages::ActuatorCommand::idle(0, 1); 3];
     cmds[0].rab_len = 2;
     cmds[0].rab_payload = [7, 9, 0, 0];
     world.act_and_step(&cmds, &[true, true, true]);
@@ -347,7 +347,7 @@ fn rab_message_through_a_wall_is_lost() {
         Motion::Fixed,
     );
     let mut world = b.build();
-    let mut cmds = vec![swarm_runtime::messages::ActuatorCommand::idle(0, 1); 2];
+    let mut cmds = vec![swarm_contract::messages::ActuatorCommand::idle(0, 1); 2];
     cmds[0].rab_len = 1;
     world.act_and_step(&cmds, &[true, true]);
     assert_eq!(frames(&mut world)[1].rab_len, 0);
@@ -364,7 +364,7 @@ fn pheromone_deposit_is_sensed_with_its_gradient_in_the_robot_frame() {
         Devices::ALL,
     );
     let mut world = b.build();
-    let mut cmd = swarm_runtime::messages::ActuatorCommand::idle(0, 1);
+    let mut cmd = swarm_contract::messages::ActuatorCommand::idle(0, 1);
     cmd.pheromone_deposit = [1.0, 0.0];
     world.act_and_step(&[cmd], &[true]);
     let f = frames(&mut world);
@@ -391,7 +391,7 @@ fn rab_loss_probability_one_drops_every_message_and_zero_drops_none() {
         b.robot("a", "c", Vec2::ZERO, 0.0, Devices::ALL);
         b.robot("b", "c", Vec2::new(0.3, 0.0), 0.0, lossy);
         let mut world = b.build();
-        let mut cmds = vec![swarm_runtime::messages::ActuatorCommand::idle(0, 1); 2];
+        let mut cmds = vec![swarm_contract::messages::ActuatorCommand::idle(0, 1); 2];
         cmds[0].rab_len = 1;
         let mut received = 0;
         for _ in 0..50 {

@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use swarm_runtime::config::Experiment;
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::config::Experiment;
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::World;
 use swarm_world::entities::TargetState;
 use swarm_world::in_process::avoid_obstacles;

@@ -4,7 +4,7 @@
 //! Nothing seen (all four zero): straight, wheels (v, v). Strongest is 0 or 1 (front left): turn right, (v, 0).
 //! Strongest is 7 or 6 (front right): turn left, (0, v). v is the `velocity` parameter in cm/s (default 12.8).
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 use crate::params::{ParamError, Params};
 

@@ -3,7 +3,7 @@
 
 pub mod epuck_obstacleavoidance;
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
 
 use crate::params::{ParamError, Params};

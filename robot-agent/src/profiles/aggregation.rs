@@ -1,4 +1,4 @@
-//! Profile `aggregation` (tasks.md section 1): Gauci et al.'s "aggregation without computation" with the
+//! Profile `aggregation` (docs/tasks.md section 1): Gauci et al.'s "aggregation without computation" with the
 //! thesis' proximity-only binary sensor, for the models in `configs/aggregation/models`.
 //!
 //! Events and procedures (v = `velocity` in cm/s, default 12.8; wheels are (left, right)):
@@ -10,18 +10,18 @@
 //! | `v0` | c | wheels (-0.7 v, -v): circle backwards, clockwise |
 //! | `v1` | c | wheels (v, -v): rotate clockwise on the spot |
 //!
-//! Exactly one of `s0`, `s1` occurs in every tick. `theta_i` must lie above the proximity noise floor (tasks.md:
+//! Exactly one of `s0`, `s1` occurs in every tick. `theta_i` must lie above the proximity noise floor (docs/tasks.md:
 //! 0.1 for sigma <= 0.03, about 0.5 for sigma = 0.3). Speeds persist until the next action, so the models'
 //! alternation spec (E3) only removes redundant commands.
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
 
-/// Default wheel speed scale in cm/s (v_max of tasks.md section 0).
+/// Default wheel speed scale in cm/s (v_max of docs/tasks.md section 0).
 pub const DEFAULT_VELOCITY: f32 = 12.8;
-/// Default threshold of the binary sensor on the front proximity pair (tasks.md section 1, sigma <= 0.03).
+/// Default threshold of the binary sensor on the front proximity pair (docs/tasks.md section 1, sigma <= 0.03).
 pub const DEFAULT_THETA_I: f32 = 0.1;
 /// Normalised wheel speeds (left, right) while nothing is seen (I = 0).
 pub const SPEEDS_I0: [f32; 2] = [-0.7, -1.0];
@@ -174,7 +174,7 @@ mod tests {
     fn aggregation_fails_on_an_event_it_has_no_callback_for() {
         let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/aggregation/models");
         let mut events = supervisors::load(&[models]).unwrap().events;
-        events.push(swarm_runtime::supervisor_gen::compiled::CompiledEvent {
+        events.push(swarm_contract::supervisor_gen::compiled::CompiledEvent {
             name: "v2".to_owned(),
             controllable: true,
         });

@@ -1,4 +1,4 @@
-//! Profile `foraging`: the operational procedures of the foraging models (tasks.md 4.3-4.5, 4.11-4.12), one per
+//! Profile `foraging`: the operational procedures of the foraging models (docs/tasks.md 4.3-4.5, 4.11-4.12), one per
 //! event of `configs/foraging/models` (G1-G8, E1-E7).
 //!
 //! The robot's memory holds its phase (tracked by the same events as E6), the tick its search or real rest began
@@ -30,12 +30,12 @@
 //! | other start, end and shadow events | c | nothing: they only move the supervisors |
 //!
 //! **LED contract with the world.** The LED shows the phase, and the loop functions `foraging_loop_functions`
-//! read it for the energy accounting and the resting ratio (tasks.md 4.13-4.14): green [`SEARCH_LED`] from
+//! read it for the energy accounting and the resting ratio (docs/tasks.md 4.13-4.14): green [`SEARCH_LED`] from
 //! `search-food` (or `start-search`) until `rest`, blue [`RETURN_LED`] from `rest` until the next search or the
 //! real rest, white [`REST_LED`] during the real rest (`Stop` until `start-search`). None of them is the target
-//! colour, so cameras never take a robot for food (tasks.md 4.2).
+//! colour, so cameras never take a robot for food (docs/tasks.md 4.2).
 
-use swarm_runtime::messages::{ActuatorCommand, GripperAction, Rgb, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, GripperAction, Rgb, SensorFrame};
 
 use super::obstacle_avoidance::{DEFAULT_THETA_OBS, DEFAULT_VELOCITY};
 use crate::params::{ParamError, Params};
@@ -51,15 +51,15 @@ pub const REST_LED: Rgb = Rgb {
     g: 255,
     b: 255,
 };
-/// Default `saw-home` threshold on the largest light reading (tasks.md 4.5).
+/// Default `saw-home` threshold on the largest light reading (docs/tasks.md 4.5).
 pub const DEFAULT_THETA_LIGHT: f32 = 0.05;
 /// Default `is-in-home` threshold on the middle ground reading (home is black).
 pub const DEFAULT_HOME_GROUND: f32 = 0.5;
 /// Default distance in cm from the robot centre to a target's LED at which `is-on-food` holds.
 pub const DEFAULT_FOOD_REACH_CM: f32 = 6.2;
-/// Default search budget in steps (ticks) (tasks.md 4.12).
+/// Default search budget in steps (ticks) (docs/tasks.md 4.12).
 pub const DEFAULT_SEARCH_BUDGET: u64 = 4000;
-/// Default length of a real rest in ticks (tasks.md 4.11).
+/// Default length of a real rest in ticks (docs/tasks.md 4.11).
 pub const DEFAULT_REST_TICKS: u64 = 1000;
 /// Bearing in radians within which `turn-to-food` drives straight on instead of pivoting.
 pub const AIM_TOLERANCE: f32 = 0.15;
@@ -92,7 +92,7 @@ pub struct Forager {
     pub food_color: Rgb,
     /// `is-on-food` distance in cm from the robot centre to the target's LED.
     pub food_reach_cm: f32,
-    /// The resting switch (tasks.md 4.11): with `false`, `did-search-expire` never holds.
+    /// The resting switch (docs/tasks.md 4.11): with `false`, `did-search-expire` never holds.
     pub resting: bool,
     /// Search budget in steps (ticks).
     pub search_budget: u64,
@@ -106,7 +106,7 @@ pub struct Forager {
 
 impl Forager {
     /// Reads the parameters (`velocity`, `theta_obs`, `theta_light`, `home_ground`, `food_color`, `food_reach_cm`,
-    /// `resting`, `search_budget_steps`, `rest_ticks`); absent ones take the defaults of tasks.md 4.5 and 4.12.
+    /// `resting`, `search_budget_steps`, `rest_ticks`); absent ones take the defaults of docs/tasks.md 4.5 and 4.12.
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
         Ok(Self {
             velocity: params.non_negative_f32_or("velocity", DEFAULT_VELOCITY)?,
@@ -160,7 +160,7 @@ impl Forager {
     fn nearest_food<'f>(
         &self,
         frame: &'f SensorFrame,
-    ) -> Option<&'f swarm_runtime::messages::CameraBlob> {
+    ) -> Option<&'f swarm_contract::messages::CameraBlob> {
         // Blobs arrive nearest first.
         frame
             .camera_blobs()
@@ -502,7 +502,7 @@ mod tests {
 
     fn with_blob(tick: u64, color: Rgb, bearing: f32, distance_cm: f32) -> SensorFrame {
         let mut f = frame(tick);
-        f.camera[0] = swarm_runtime::messages::CameraBlob {
+        f.camera[0] = swarm_contract::messages::CameraBlob {
             color,
             bearing,
             distance_cm,

@@ -9,9 +9,9 @@ pub mod pheromone_foraging;
 pub mod synchronisation;
 pub mod timer;
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
-use swarm_runtime::player::EventCallbacks;
-use swarm_runtime::supervisor_gen::compiled::CompiledEvent;
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::player::EventCallbacks;
+use swarm_contract::supervisor_gen::compiled::CompiledEvent;
 use thiserror::Error;
 
 use crate::binding::{BindError, bind};

@@ -1,5 +1,5 @@
 //! Profiles `obstacle_avoidance` (ptSCT models) and `obstacle_avoidance_sct` (plain-SCT models with a timer
-//! generator), tasks.md section 3: a random walk that turns away from obstacles.
+//! generator), docs/tasks.md section 3: a random walk that turns away from obstacles.
 //!
 //! Events and procedures (v = `velocity` in cm/s, default 12.8; wheels are (left, right) in cm/s):
 //!
@@ -16,7 +16,7 @@
 //! the LED persist until the next action, as on the robot. The plain-SCT profile adds timer generator 1
 //! (`start_timer_1`, `timer_1_lw_5`, `inc_timer_1`, `timer_1_eq_5`, `end_timer_1`; see [`super::timer`]).
 
-use swarm_runtime::messages::{ActuatorCommand, Rgb, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, Rgb, SensorFrame};
 
 use super::timer::{self, StepTimer};
 use crate::params::{ParamError, Params};
@@ -24,7 +24,7 @@ use crate::profile::{Procedure, Profile};
 
 /// Default wheel speed in cm/s (the thesis' `velocity="12.8"`, the e-puck maximum).
 pub const DEFAULT_VELOCITY: f32 = 12.8;
-/// Default obstacle threshold on the front proximity readings (tasks.md section 3).
+/// Default obstacle threshold on the front proximity readings (docs/tasks.md section 3).
 pub const DEFAULT_THETA_OBS: f32 = 0.1;
 /// Increments of timer generator 1 in the plain-SCT models (the ptSCT models' `Go` lower bound).
 pub const SCT_TIMER_TICKS: u16 = 5;

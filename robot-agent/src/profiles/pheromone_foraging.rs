@@ -1,12 +1,12 @@
 //! Profile `pheromone_foraging`: the foraging procedures (see [`super::foraging`]) plus artificial pheromones
-//! (tasks.md 5), for the models of `configs/pheromone_foraging/models` (G1-G9, E1-E7 with the 5.4 changes).
+//! (docs/tasks.md 5), for the models of `configs/pheromone_foraging/models` (G1-G9, E1-E7 with the 5.4 changes).
 //!
 //! | event | kind | procedure |
 //! |---|---|---|
 //! | `smell-food-trail` / `smell-home-trail` | u | the food / home channel's concentration under the robot > `theta_p` (default 0.05) |
 //! | `follow-food-trail` / `follow-home-trail` | c | steer up that channel's gradient (pivot towards it, straight on within 0.15 rad) |
 //!
-//! Deposits are folded into the motion (tasks.md 5.4): after every action the robot sets what it lays per tick
+//! Deposits are folded into the motion (docs/tasks.md 5.4): after every action the robot sets what it lays per tick
 //! until its next action. While carrying a target it lays the **food trail**, `q_food` (default 1) faded by
 //! exp(-ticks since the pick-up / `trail_fade_ticks`) (default 400); while searching without a target it lays the
 //! **home trail**, `q_home` (default 1); otherwise nothing. The fade is our choice: it makes each trail strongest
@@ -14,13 +14,13 @@
 //! rho = 0.001 per tick, would leave the freshest end, near home, strongest). Channels are the sensor's channel
 //! indices `food_channel` (default 0) and `home_channel` (default 1).
 
-use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use super::foraging::{self, Forager, Phase};
 use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
 
-/// Default smell threshold θ_p (tasks.md 5.3).
+/// Default smell threshold θ_p (docs/tasks.md 5.3).
 pub const DEFAULT_THETA_P: f32 = 0.05;
 /// Default ticks over which the food-trail deposit fades by a factor e.
 pub const DEFAULT_TRAIL_FADE_TICKS: f32 = 400.0;

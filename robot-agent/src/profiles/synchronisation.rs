@@ -1,5 +1,5 @@
 //! Profiles `synchronisation` (ptSCT models) and `synchronisation_sct` (plain-SCT models with timer generators
-//! 1-3), tasks.md section 2: firefly-like synchronisation of a counter through LED flashes.
+//! 1-3), docs/tasks.md section 2: firefly-like synchronisation of a counter through LED flashes.
 //!
 //! Events and procedures (T = `top`, default 50; alpha = `alpha`, default 0.1):
 //!
@@ -25,19 +25,19 @@
 //! profile adds timer generators 1 (before `timeout`), 2 (before `sync`) and 3 (before `led_off`), each a one-step
 //! delay (`start_timer_x`, `timer_x_lw_1`, `inc_timer_x`, `timer_x_eq_1`, `end_timer_x`; see [`super::timer`]).
 
-use swarm_runtime::messages::{ActuatorCommand, Rgb, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, Rgb, SensorFrame};
 
 use super::timer::{self, StepTimer};
 use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
 
-/// Default counter ceiling T (tasks.md section 2).
+/// Default counter ceiling T (docs/tasks.md section 2).
 pub const DEFAULT_TOP: u32 = 50;
-/// Default coupling constant alpha (tasks.md section 2).
+/// Default coupling constant alpha (docs/tasks.md section 2).
 pub const DEFAULT_ALPHA: f32 = 0.1;
 /// Default silence of `saw_led` after a `sync`, in ticks: the ptSCT models' flash length.
 pub const DEFAULT_REFRACTORY: u64 = 5;
-/// The flash colour (tasks.md section 2 recommends yellow).
+/// The flash colour (docs/tasks.md section 2 recommends yellow).
 pub const FLASH: Rgb = Rgb {
     r: 255,
     g: 255,
@@ -300,7 +300,7 @@ impl Profile for SynchronisationSct {
 mod tests {
     use std::path::Path;
 
-    use swarm_runtime::messages::CameraBlob;
+    use swarm_contract::messages::CameraBlob;
 
     use super::*;
     use crate::profiles::bind_profile;

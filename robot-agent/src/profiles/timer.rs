@@ -1,11 +1,11 @@
-//! Timer generators for plain SCT (tasks.md section 2): a counter driven one step per tick by supervisor events.
+//! Timer generators for plain SCT (docs/tasks.md section 2): a counter driven one step per tick by supervisor events.
 //!
 //! Plain SCT has no lower bounds, so a delay of n ticks is modelled by a timer plant with the events
 //! `start_timer_x` (c, counter to 0), `timer_x_lw_n` (u, running and counter < n), `inc_timer_x` (c, counter + 1),
 //! `timer_x_eq_n` (u, running and counter reached n) and `end_timer_x` (c, stop). The procedures here are generic
 //! over any profile memory that holds a [`StepTimer`], so every plain-SCT profile reuses them.
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 /// The memory of one timer generator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,10 +1,10 @@
-//! Aggregation metrics (tasks.md 1): clusters of robots over time.
+//! Aggregation metrics (docs/tasks.md 1): clusters of robots over time.
 //!
 //! A cluster is a connected component of live robots whose bodies are at most `gap` apart (default one robot
 //! diameter, 0.07 m, so centres at most 0.14 m apart). Every tick the loop functions count the clusters and the
 //! size of the largest one, remember the first tick at which the largest cluster holds more than `fraction`
 //! (default 0.9) of the live robots, and every `sample_interval` seconds (default 5) add a sample to the series
-//! in `summary.json`. tasks.md gives no stop condition: the run ends at the experiment's length or `--ticks`.
+//! in `summary.json`. docs/tasks.md gives no stop condition: the run ends at the experiment's length or `--ticks`.
 //!
 //! Configuration: `<loop_functions label="aggregation_loop_functions"><aggregation gap="0.07"
 //! sample_interval="5" fraction="0.9"/></loop_functions>` (the child and each attribute are optional).
@@ -12,7 +12,7 @@
 
 use serde::Serialize;
 use serde_json::json;
-use swarm_runtime::messages::ActuatorCommand;
+use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::Arena;
 use crate::entities::ROBOT_RADIUS;
@@ -23,11 +23,11 @@ use crate::loop_functions::{LoopFunctions, LoopFunctionsParams, params::ParamRea
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "aggregation_loop_functions";
 /// Default largest body-to-body gap between neighbours of a cluster in metres: one robot diameter, 2 x
-/// [`ROBOT_RADIUS`] (tasks.md 1).
+/// [`ROBOT_RADIUS`] (docs/tasks.md 1).
 pub const DEFAULT_GAP: f64 = 0.07;
 /// Default time between two samples of the series, in seconds.
 pub const DEFAULT_SAMPLE_INTERVAL: f32 = 5.0;
-/// Default fraction of the robots the largest cluster must exceed (tasks.md 1: 0.9).
+/// Default fraction of the robots the largest cluster must exceed (docs/tasks.md 1: 0.9).
 pub const DEFAULT_FRACTION: f64 = 0.9;
 /// Samples the series holds before it would have to grow (one hour at the default interval).
 const RESERVED_SAMPLES: usize = 720;

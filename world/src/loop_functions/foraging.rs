@@ -1,4 +1,4 @@
-//! Foraging loop functions (tasks.md 4.9, 4.13, 4.14), label `foraging_loop_functions`: deliveries at home, the
+//! Foraging loop functions (docs/tasks.md 4.9, 4.13, 4.14), label `foraging_loop_functions`: deliveries at home, the
 //! swarm's energy account, the metrics TO, T88%, R2S, energy per time unit and the fixed-time yield, and the stop
 //! condition "all targets delivered".
 //!
@@ -12,15 +12,15 @@
 //! robot) lies in the strip: a robot senses home with its ground sensors, 3 cm ahead of its centre, so its centre
 //! may still be outside when it drops at the border. A target dropped elsewhere stays where it fell.
 //!
-//! **Phases from LEDs.** The world cannot see a robot's supervisors, so the phase of tasks.md 4.13 is read from the
-//! LED the robot's profile shows (robot-agent's `foraging` profile): green = search phase, blue = rest phase on
+//! **Phases from LEDs.** The world cannot see a robot's supervisors, so the phase of docs/tasks.md 4.13 is read
+//! from the LED the robot's profile shows (robot-agent's `foraging` profile): green = search phase, blue = rest phase on
 //! its way home, white = real rest. Each tick every live robot costs Et when it carries a target, else Es in the
 //! search phase, else Er. R2S counts white robots as resting and green ones as searching.
 //!
 //! Everything per tick is arithmetic on counters: nothing allocates after the first tick.
 
 use serde_json::json;
-use swarm_runtime::messages::{ActuatorCommand, Rgb};
+use swarm_contract::messages::{ActuatorCommand, Rgb};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{TargetId, TargetState};
@@ -38,7 +38,7 @@ pub const REST_LED: Rgb = Rgb {
     g: 255,
     b: 255,
 };
-/// Share of the targets whose delivery time is T88% (tasks.md 4.14).
+/// Share of the targets whose delivery time is T88% (docs/tasks.md 4.14).
 pub const T88_SHARE: f64 = 0.88;
 
 /// The `<foraging>` parameters.
@@ -61,7 +61,7 @@ pub struct ForagingParams {
 }
 
 impl Default for ForagingParams {
-    /// The thesis' values (tasks.md 4.13) and the recommended home strip.
+    /// The thesis' values (docs/tasks.md 4.13) and the recommended home strip.
     fn default() -> Self {
         Self {
             home_y_max: -2.0,
@@ -326,7 +326,7 @@ impl LoopFunctions for Foraging {
 mod tests {
     use std::collections::BTreeMap;
 
-    use swarm_runtime::messages::GripperAction;
+    use swarm_contract::messages::GripperAction;
 
     use super::*;
     use crate::devices::Devices;

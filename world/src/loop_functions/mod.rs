@@ -12,7 +12,7 @@ pub mod synchronisation;
 
 use std::collections::BTreeMap;
 
-use swarm_runtime::messages::ActuatorCommand;
+use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::Arena;
 use crate::error::WorldError;

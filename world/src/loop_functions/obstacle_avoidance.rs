@@ -1,11 +1,11 @@
-//! Obstacle-avoidance metrics (tasks.md 3): body contacts per robot-minute and the fraction of robot-ticks
+//! Obstacle-avoidance metrics (docs/tasks.md 3): body contacts per robot-minute and the fraction of robot-ticks
 //! spent moving forward.
 //!
 //! A contact is counted when it starts, once for each robot involved. A live robot moves forward in a tick when
 //! both wheels turn forward at the same speed (within 1 %), as the `Go` action does; turns do not count.
 
 use serde_json::json;
-use swarm_runtime::messages::ActuatorCommand;
+use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::Arena;
 use crate::error::WorldError;

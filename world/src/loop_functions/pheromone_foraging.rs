@@ -1,14 +1,14 @@
-//! Pheromone-foraging loop functions (tasks.md 5), label `pheromone_foraging_loop_functions`: everything of
+//! Pheromone-foraging loop functions (docs/tasks.md 5), label `pheromone_foraging_loop_functions`: everything of
 //! [`super::foraging`], plus trail removal at exhausted sources.
 //!
 //! Configuration: the `<foraging>` child as for foraging, and `<trails food_channel="0" source_radius="0.5"/>`.
 //! When a robot picks up a target and no other target lies in the arena within `source_radius` metres of it, the
-//! source is exhausted: the world clears the food-trail channel within that radius (tasks.md 5.2, the world-side
+//! source is exhausted: the world clears the food-trail channel within that radius (docs/tasks.md 5.2, the world-side
 //! alternative) and counts an erase event. The pheromone field itself (deposits, evaporation, diffusion) is the
 //! world's medium, configured under `<media><pheromone>`.
 
 use serde_json::json;
-use swarm_runtime::messages::{ActuatorCommand, PHEROMONE_CHANNELS};
+use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::TargetState;
@@ -136,7 +136,7 @@ impl LoopFunctions for PheromoneForaging {
 
 #[cfg(test)]
 mod tests {
-    use swarm_runtime::messages::{GripperAction, Rgb};
+    use swarm_contract::messages::{GripperAction, Rgb};
 
     use super::*;
     use crate::devices::Devices;

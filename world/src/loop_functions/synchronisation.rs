@@ -1,7 +1,7 @@
-//! Firefly-synchronisation metrics (tasks.md 2), observed from the robots' LEDs only: a flash starts in the tick
+//! Firefly-synchronisation metrics (docs/tasks.md 2), observed from the robots' LEDs only: a flash starts in the tick
 //! a robot's LED goes from off to on.
 //!
-//! - **Window fraction** (tasks.md's synchrony measure): at tick t, the fraction of the live robots whose latest
+//! - **Window fraction** (docs/tasks.md's synchrony measure): at tick t, the fraction of the live robots whose latest
 //!   flash started within the last `window` ticks (default w = 5), t - window < start <= t. The series reports
 //!   its largest value in each sample interval, i.e. the size of the best-synchronised flash of that interval.
 //! - **Time to synchrony**: the first tick at which the window fraction reaches 1.
@@ -14,14 +14,14 @@
 //!   few ticks per robot never brings to 1.
 //!
 //! Configuration: `<loop_functions label="synchronisation_loop_functions"><synchronisation window="5"
-//! sample_interval="5" order="0.9"/></loop_functions>` (optional). tasks.md gives no stop condition. A tick allocates nothing
-//! once the per-robot record exists (made on the first tick); the series is reserved.
+//! sample_interval="5" order="0.9"/></loop_functions>` (optional). docs/tasks.md gives no stop condition. A tick
+//! allocates nothing once the per-robot record exists (made on the first tick); the series is reserved.
 
 use std::f64::consts::TAU;
 
 use serde::Serialize;
 use serde_json::json;
-use swarm_runtime::messages::ActuatorCommand;
+use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::Arena;
 use crate::error::WorldError;
@@ -29,7 +29,7 @@ use crate::loop_functions::{LoopFunctions, LoopFunctionsParams, params::ParamRea
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "synchronisation_loop_functions";
-/// Default synchrony window w in ticks (tasks.md 2).
+/// Default synchrony window w in ticks (docs/tasks.md 2).
 pub const DEFAULT_WINDOW: u64 = 5;
 /// Default time between two samples of the series, in seconds.
 pub const DEFAULT_SAMPLE_INTERVAL: f64 = 5.0;
@@ -255,7 +255,7 @@ mod tests {
     use crate::devices::Devices;
     use crate::geometry::Vec2;
     use crate::world::{World, WorldBuilder};
-    use swarm_runtime::messages::Rgb;
+    use swarm_contract::messages::Rgb;
 
     const YELLOW: Rgb = Rgb {
         r: 255,

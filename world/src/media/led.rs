@@ -1,7 +1,7 @@
 //! The LED medium: every lit LED in the arena (robots, targets lying in the arena, lights) with a grid over their
 //! positions for the cameras' range queries.
 
-use swarm_runtime::messages::Rgb;
+use swarm_contract::messages::Rgb;
 
 use crate::entities::{Light, ROBOT_LED_HEIGHT, Robot, Target, TargetState};
 use crate::geometry::{Aabb, Vec2};

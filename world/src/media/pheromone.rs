@@ -1,8 +1,8 @@
-//! The artificial pheromone field (tasks.md 5.2): one scalar grid per channel over the arena, with deposits at
+//! The artificial pheromone field (docs/tasks.md 5.2): one scalar grid per channel over the arena, with deposits at
 //! robot positions, per-channel evaporation `tau <- (1 - rho) tau` and an optional 3 x 3 diffusion blur of weight
 //! D, stepped once per tick after physics. Concentrations never go below zero (negative deposits erase).
 
-use swarm_runtime::messages::PHEROMONE_CHANNELS;
+use swarm_contract::messages::PHEROMONE_CHANNELS;
 
 use crate::geometry::Vec2;
 
@@ -117,7 +117,7 @@ impl PheromoneField {
     }
 
     /// Sets `channel` to zero in every cell whose centre lies within `radius` metres of `centre` (a loop function
-    /// erasing the trail of an exhausted source, tasks.md 5.2); returns how many cells held pheromone.
+    /// erasing the trail of an exhausted source, docs/tasks.md 5.2); returns how many cells held pheromone.
     pub fn clear_disc(&mut self, channel: usize, centre: Vec2, radius: f32) -> usize {
         if channel >= PHEROMONE_CHANNELS || !self.touched[channel] {
             return 0;

@@ -1,7 +1,7 @@
 //! The range-and-bearing medium: the messages robots broadcast this tick, placed at the senders' positions after
 //! the physics step, with a grid for the receivers' range queries. Dead robots send nothing.
 
-use swarm_runtime::messages::RAB_PAYLOAD_BYTES;
+use swarm_contract::messages::RAB_PAYLOAD_BYTES;
 
 use crate::entities::Robot;
 use crate::geometry::{Aabb, Vec2};

@@ -9,14 +9,11 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use swarm_runtime::launcher::EVENT_TABLES_FILE;
+use swarm_contract::run_dir::{EVENT_TABLES_FILE, EVENTS_FILE};
 
 use super::csv_line::CsvLine;
 use crate::arena::Arena;
 use crate::error::WorldError;
-
-/// File name of the event record in the run directory.
-pub const EVENTS_FILE: &str = "events.csv";
 
 /// One row of `events.csv`, before formatting.
 #[derive(Clone, Copy, Debug)]

@@ -2,7 +2,7 @@
 //!
 //! A tick's batch ends with its poses, and the events file is flushed before the trajectory file. So whenever
 //! the trajectory holds a tick for every robot, the events of that tick are on disk too: the launcher's cut-back
-//! after a world death (`runtime/src/launcher/records.rs`) trusts the trajectory to say which ticks are whole.
+//! after a world death (`runtime/cli/src/launcher/records.rs`) trusts the trajectory to say which ticks are whole.
 
 use super::background::RowWriter;
 use super::events::{EventRow, EventsWriter};

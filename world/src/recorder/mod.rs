@@ -11,21 +11,20 @@ pub mod files;
 pub mod snapshot;
 pub mod trajectory;
 
+use swarm_contract::run_dir::{SUMMARY_FILE, TRAJECTORY_FILE};
+
 pub use background::{Background, RowWriter};
-pub use events::{EVENTS_FILE, EventRow, EventsWriter};
+pub use events::{EventRow, EventsWriter};
 pub use files::{RecordFiles, RecordRow};
-pub use trajectory::{PoseRow, TRAJECTORY_FILE, TrajectoryWriter};
+pub use trajectory::{PoseRow, TrajectoryWriter};
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use swarm_runtime::messages::ActuatorCommand;
+use swarm_contract::messages::ActuatorCommand;
 
 use crate::error::WorldError;
 use crate::world::World;
-
-/// Name of the summary file in the run directory.
-pub const SUMMARY_FILE: &str = "summary.json";
 
 /// Records one run into a directory.
 pub struct Recorder {
@@ -88,7 +87,7 @@ impl Recorder {
 
     fn snapshot(&self, world: &World) -> Result<(), WorldError> {
         let tick = world.tick();
-        snapshot::render(world, &self.dir.join(format!("snapshot_{tick:06}.png")))
+        snapshot::render(world, &swarm_contract::run_dir::snapshot(&self.dir, tick))
     }
 
     /// Returns once every row recorded so far is in its file. The world calls it before it reports a scheduled

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use swarm_runtime::messages::{PHEROMONE_CHANNELS, Rgb};
+use swarm_contract::messages::{PHEROMONE_CHANNELS, Rgb};
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use crate::arena::Arena;

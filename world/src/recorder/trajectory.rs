@@ -5,14 +5,12 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use swarm_runtime::messages::Rgb;
+use swarm_contract::messages::Rgb;
 
 use super::csv_line::CsvLine;
 use crate::arena::Arena;
 use crate::error::WorldError;
 
-/// Name of the trajectory file in the run directory.
-pub const TRAJECTORY_FILE: &str = "trajectory.csv";
 /// The header line.
 pub const TRAJECTORY_HEADER: &str = "tick,robot,x,y,heading,led_r,led_g,led_b,alive";
 

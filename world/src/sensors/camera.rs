@@ -1,10 +1,10 @@
 //! The omnidirectional camera: the lit LEDs within 0.35 m, lower than the camera, not the robot's own and not
 //! hidden behind a body; reported nearest first as colour, bearing and distance in cm, at most
-//! `swarm_runtime::messages::MAX_CAMERA_BLOBS` of them.
+//! `swarm_contract::messages::MAX_CAMERA_BLOBS` of them.
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use swarm_runtime::messages::{CameraBlob, SensorFrame};
+use swarm_contract::messages::{CameraBlob, SensorFrame};
 
 use crate::devices::CameraOptions;
 use crate::geometry::{Vec2, wrap_angle};

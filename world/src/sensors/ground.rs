@@ -2,7 +2,7 @@
 //! wheel axis, index 0 on the left.
 
 use rand_chacha::ChaCha8Rng;
-use swarm_runtime::messages::GROUND_SENSORS;
+use swarm_contract::messages::GROUND_SENSORS;
 
 use crate::geometry::Vec2;
 use crate::sensors::noise;

@@ -5,7 +5,7 @@
 //! over lights and clamped to [0, 1]. A light is occluded when a body's top is above the sight line.
 
 use rand_chacha::ChaCha8Rng;
-use swarm_runtime::messages::LIGHT_SENSORS;
+use swarm_contract::messages::LIGHT_SENSORS;
 
 use crate::entities::Light;
 use crate::geometry::wrap_angle;

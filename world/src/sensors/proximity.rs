@@ -5,7 +5,7 @@
 //! instead. A ray starts on the body edge and reaches 5 cm; it cannot tell robots, obstacles and targets apart.
 
 use rand_chacha::ChaCha8Rng;
-use swarm_runtime::messages::PROXIMITY_SENSORS;
+use swarm_contract::messages::PROXIMITY_SENSORS;
 
 use crate::devices::ProximityOptions;
 use crate::entities::ROBOT_RADIUS;

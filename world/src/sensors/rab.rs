@@ -1,11 +1,11 @@
 //! The range-and-bearing receiver: messages broadcast in the previous tick by other robots whose emitter range
 //! reaches this robot and whose line of sight is not cut by a body taller than a robot. Range is reported in cm
 //! minus two body radii and bearing in the receiver's frame (the IRIDIA convention); each message may be lost
-//! with the receiver's `loss_probability`. Nearest first, at most `swarm_runtime::messages::MAX_RAB_MESSAGES`.
+//! with the receiver's `loss_probability`. Nearest first, at most `swarm_contract::messages::MAX_RAB_MESSAGES`.
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use swarm_runtime::messages::{RabMessage, SensorFrame};
+use swarm_contract::messages::{RabMessage, SensorFrame};
 
 use crate::devices::RabOptions;
 use crate::entities::{ROBOT_HEIGHT, ROBOT_RADIUS};

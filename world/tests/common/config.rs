@@ -1,8 +1,8 @@
-//! The thesis' example experiment (epuck-and-world.md 5) built as a typed model, plus builders for variants.
+//! The thesis' example experiment (docs/epuck-and-world.md 5) built as a typed model, plus builders for variants.
 
 use std::path::PathBuf;
 
-use swarm_runtime::config::*;
+use swarm_contract::config::*;
 
 /// A location on `line` (column 5), so items sort in file order.
 pub fn at(line: u32) -> Location {

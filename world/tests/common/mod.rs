@@ -4,7 +4,7 @@
 
 pub mod config;
 
-use swarm_runtime::messages::{ActuatorCommand, SensorFrame};
+use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_world::WorldBuilder;
 use swarm_world::geometry::{Placed, Shape, Vec2};
 use swarm_world::physics::Motion;

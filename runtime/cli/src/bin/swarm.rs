@@ -1,0 +1,449 @@
+//! `swarm`: runs experiments.
+//!
+//! `swarm run <config.argos>` starts the world and one agent process per robot, shows progress, and leaves the
+//! run directory (summary, trajectories, events, snapshot, logs). Ctrl-C stops the run cleanly: the world finishes
+//! its tick and flushes its records, and every process and shared-memory file of the run is removed.
+//! `swarm run --fault "kill robots=3 tick=50"` adds faults to the configuration's `<faults>`, and
+//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot> | kill-host <host>` drives a live
+//! run (docs/faults.md).
+//!
+//! `swarm host --connect <endpoint>` runs one machine's share of multi-host runs (docs/hosts.md); `swarm run
+//! --hosts a,b` places a run's robots on such hosts.
+//!
+//! `swarm experiment <grid.toml>` runs a grid of configurations x seeds into a batch folder (`docs/experiments.md`):
+//! several runs at once, resumable, with `results.csv`, figures and `report.md`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::{Args, Parser, Subcommand};
+use swarm_cli::bench::BenchOptions;
+use swarm_cli::experiment::{self, ExperimentOptions};
+use swarm_cli::launcher::control::{self, CtlCommand};
+use swarm_cli::launcher::{self, RunOptions};
+use swarm_contract::config::hosts::TlsFiles;
+use swarm_contract::process::binaries::Binaries;
+use swarm_remote::codec::DEFAULT_MAX_PAYLOAD;
+use swarm_remote::host::{self, HostOptions};
+use swarm_remote::plan::HostsArgs;
+use swarm_remote::session::{DEFAULT_LEASE, ZenohOptions};
+
+/// Runs swarms of robot processes executing ptSCT supervisors.
+#[derive(Debug, Parser)]
+#[command(name = "swarm", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Commands,
+}
+
+#[derive(Debug, Subcommand)]
+enum Commands {
+    /// Run an experiment: one world process and one robot-agent process per robot.
+    Run {
+        /// The experiment configuration (.argos).
+        config: PathBuf,
+        /// Number of robots (overrides the quantity of the configuration's e-puck <distribute>).
+        #[arg(long)]
+        robots: Option<u32>,
+        /// Ticks to run (overrides the configuration's experiment length).
+        #[arg(long)]
+        ticks: Option<u64>,
+        /// Run seed (overrides the configuration's random_seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Run directory (default: runs/<config name>-<unix seconds>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Milliseconds a tick waits for a missing command before it goes on without it.
+        #[arg(long = "tick-deadline-ms")]
+        tick_deadline_ms: Option<u64>,
+        /// Milliseconds the run waits for its robots (or hosts) to join before it gives up (default 120000).
+        #[arg(long = "join-timeout-ms")]
+        join_timeout_ms: Option<u64>,
+        /// Do not draw a progress bar.
+        #[arg(long)]
+        no_progress: bool,
+        /// Real-time mode: pace the ticks at the configuration's ticks_per_second; summary.json says whether
+        /// every tick kept its slot.
+        #[arg(long)]
+        real_time: bool,
+        /// A fault added to the configuration's <faults>, as the element in words (repeatable), e.g.
+        /// "kill robots=3 tick=50", "chaos every=2 count=1", "restart policy=on-failure max_restarts=2".
+        #[arg(long = "fault", value_name = "FAULT")]
+        faults: Vec<String>,
+        /// Hosts to run the robots on.
+        #[command(flatten)]
+        hosts: HostsArgs,
+    },
+    /// Drive a live run from another terminal: list its robots, kill, freeze or thaw one.
+    Ctl {
+        /// The run directory of the live run (its `--out`), or its control socket.
+        run: PathBuf,
+        #[command(subcommand)]
+        request: CtlRequestArg,
+    },
+    /// Benchmark: the whole system at ARGoS' obstacle-avoidance density (one process per robot), the bare
+    /// lockstep transport, and a real-time check; prints Markdown tables and writes <out>/bench.json.
+    Bench(BenchArgs),
+    /// Run this machine's share of multi-host runs: announce this host, start the robots the world assigns it,
+    /// and bridge their frames and commands over zenoh.
+    Host(HostCli),
+    /// Run a grid of configurations x seeds (a TOML grid file); a rerun continues where a stopped one ended.
+    Experiment {
+        /// The grid file (.toml).
+        grid: PathBuf,
+        /// Batch folder (overrides the grid's `out`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Runs at once (default: one per core, fewer if memory is short).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not draw a progress bar.
+        #[arg(long)]
+        no_progress: bool,
+    },
+}
+
+/// What `swarm ctl` asks a live run.
+#[derive(Debug, Subcommand)]
+enum CtlRequestArg {
+    /// Every robot with its agent's process id, state and restarts.
+    List,
+    /// SIGKILL a robot's agent (it is restarted if its restart policy says so).
+    Kill {
+        /// Robot index.
+        robot: u32,
+    },
+    /// SIGSTOP a robot's agent; the world stops waiting for it after one tick deadline.
+    Freeze {
+        /// Robot index.
+        robot: u32,
+    },
+    /// SIGCONT a frozen robot's agent; it takes part again from the tick after its next answer.
+    Thaw {
+        /// Robot index.
+        robot: u32,
+    },
+    /// Make a `swarm host` daemon of a multi-host run die, as if its machine failed: its robots are dead from
+    /// the tick the world notices.
+    KillHost {
+        /// Host name.
+        host: String,
+    },
+}
+
+/// Flags of `swarm bench`.
+#[derive(Debug, clap::Args)]
+struct BenchArgs {
+    /// Robot counts, comma-separated (each needs <configs>/density_N<N>.argos).
+    #[arg(long, value_delimiter = ',', default_values_t = [10, 100, 1000])]
+    sizes: Vec<u32>,
+    /// Folder of the density configurations.
+    #[arg(long, default_value = "configs/obstacle_avoidance")]
+    configs: PathBuf,
+    /// Ticks per whole-system run (default 200,000 / N, clamped to 200..2,000).
+    #[arg(long)]
+    ticks: Option<u64>,
+    /// Whole-system runs per size; figures are medians.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
+    /// Folder for run directories and bench.json.
+    #[arg(long, default_value = "runs/bench")]
+    out: PathBuf,
+    /// Skip the whole-system runs.
+    #[arg(long)]
+    no_system: bool,
+    /// Skip the bare lockstep.
+    #[arg(long)]
+    no_bare: bool,
+    /// Also run a real-time check with this many robots (needs density_N<N>.argos; N = 2000 ships at 10 ticks/s).
+    #[arg(long)]
+    real_time_robots: Option<u32>,
+    /// Ticks of the real-time check.
+    #[arg(long, default_value_t = swarm_cli::bench::DEFAULT_REAL_TIME_TICKS)]
+    real_time_ticks: u64,
+}
+
+/// Flags of `swarm host`.
+#[derive(Debug, Args)]
+struct HostCli {
+    /// The world's zenoh endpoint, e.g. tcp/10.0.0.1:7447.
+    #[arg(long)]
+    connect: String,
+    /// Name of this host in placements (default: the machine's host name, dots as '-').
+    #[arg(long)]
+    name: Option<String>,
+    /// Most robots this host accepts in one run.
+    #[arg(long, default_value_t = 1000)]
+    capacity: u32,
+    /// Link lease in milliseconds: a frozen or cut-off host is noticed after about this long.
+    #[arg(long = "lease-ms", default_value_t = DEFAULT_LEASE.as_millis() as u64)]
+    lease_ms: u64,
+    /// A zenoh configuration file (JSON5) to start from (e.g. for TLS).
+    #[arg(long = "zenoh-config")]
+    zenoh_config: Option<PathBuf>,
+    /// zenoh user name (with --password-file).
+    #[arg(long, requires = "password_file")]
+    user: Option<String>,
+    /// File holding the zenoh password.
+    #[arg(long = "password-file", requires = "user")]
+    password_file: Option<PathBuf>,
+    /// For a tls/... endpoint: the PEM certificate authority the world's certificate must be signed by.
+    #[arg(long = "tls-root-ca")]
+    tls_root_ca: Option<PathBuf>,
+    /// For mutual TLS: this host's PEM certificate (with --tls-private-key).
+    #[arg(long = "tls-certificate", requires = "tls_private_key")]
+    tls_certificate: Option<PathBuf>,
+    /// For mutual TLS: this host's PEM private key (with --tls-certificate).
+    #[arg(long = "tls-private-key", requires = "tls_certificate")]
+    tls_private_key: Option<PathBuf>,
+    /// Folder for the agents' logs (default: <temp>/swarm-host-<name>).
+    #[arg(long)]
+    logs: Option<PathBuf>,
+}
+
+fn main() -> ExitCode {
+    swarm_contract::logging::init("info");
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let options = BenchOptions {
+        configs_dir: args.configs,
+        sizes: args.sizes,
+        ticks: args.ticks,
+        repeat: args.repeat,
+        out: args.out.clone(),
+        system: !args.no_system,
+        bare: !args.no_bare,
+        real_time_robots: args.real_time_robots,
+        real_time_ticks: args.real_time_ticks,
+    };
+    let progress = indicatif::ProgressBar::new_spinner();
+    progress.enable_steady_tick(Duration::from_millis(200));
+    progress.set_message("measuring");
+    let report = swarm_cli::bench::run(&options, &stop, |partial| {
+        progress.set_message(format!(
+            "measured {} whole-system, {} bare, {} real-time",
+            partial.system.len(),
+            partial.bare.len(),
+            usize::from(partial.real_time.is_some())
+        ));
+    })?;
+    progress.finish_and_clear();
+    print!("{}", swarm_cli::bench::markdown(&report));
+    println!("written: {}", args.out.join("bench.json").display());
+    Ok(())
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Commands::Bench(args) => bench(args),
+        Commands::Experiment {
+            grid,
+            out,
+            jobs,
+            no_progress,
+        } => run_experiment(ExperimentOptions {
+            grid,
+            out,
+            jobs,
+            progress: !no_progress,
+        }),
+        Commands::Run {
+            config,
+            robots,
+            ticks,
+            seed,
+            out,
+            tick_deadline_ms,
+            join_timeout_ms,
+            no_progress,
+            real_time,
+            faults,
+            hosts,
+        } => {
+            let stop = Arc::new(AtomicBool::new(false));
+            let flag = Arc::clone(&stop);
+            ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+                .context("installing the Ctrl-C handler")?;
+            let options = RunOptions {
+                config: config.clone(),
+                robots,
+                ticks,
+                seed,
+                out,
+                progress: !no_progress,
+                tick_deadline: tick_deadline_ms.map(Duration::from_millis),
+                join_timeout: join_timeout_ms.map(Duration::from_millis),
+                real_time,
+                faults,
+                hosts,
+            };
+            let report = launcher::run(&options, stop)
+                .with_context(|| format!("running {}", config.display()))?;
+            let ticking =
+                (report.wall_seconds - report.time_to_first_tick_seconds).max(f64::EPSILON);
+            let steps = f64::from(report.robots) * report.ticks as f64;
+            println!(
+                "{} after {} ticks: {} robots, seed {}, {:.1} s ({:.2} s to the first tick), {:.0} robot-steps/s, \
+                 {} deaths, {} faults, {} alive; records in {}",
+                if report.interrupted {
+                    "stopped"
+                } else {
+                    "finished"
+                },
+                report.ticks,
+                report.robots,
+                report.seed,
+                report.wall_seconds,
+                report.time_to_first_tick_seconds,
+                steps / ticking,
+                report.deaths.len(),
+                report.faults.len(),
+                report.alive_final,
+                report.out_dir.display()
+            );
+            Ok(())
+        }
+        Commands::Ctl { run, request } => ctl(&run, request),
+        Commands::Host(cli) => run_host(cli),
+    }
+}
+
+/// `swarm ctl`: one request to a live run, its answer on standard output.
+fn ctl(run: &std::path::Path, request: CtlRequestArg) -> anyhow::Result<()> {
+    let command = match request {
+        CtlRequestArg::List => CtlCommand::List,
+        CtlRequestArg::Kill { robot } => CtlCommand::Kill(robot),
+        CtlRequestArg::Freeze { robot } => CtlCommand::Freeze(robot),
+        CtlRequestArg::Thaw { robot } => CtlCommand::Thaw(robot),
+        CtlRequestArg::KillHost { host } => CtlCommand::KillHost(host),
+    };
+    let shown = command.to_string();
+    let answer = control::request(run, command)
+        .with_context(|| format!("swarm ctl {} {shown}", run.display()))?;
+    print!("{answer}");
+    Ok(())
+}
+
+/// `swarm host`: serves runs until Ctrl-C or SIGTERM.
+fn run_host(cli: HostCli) -> anyhow::Result<()> {
+    let name = match cli.name {
+        Some(name) => name,
+        // Host names are one zenoh key chunk: dots and other characters become '-'.
+        None => std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .context("reading the machine's host name (or pass --name)")?
+            .trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '_' {
+                    c
+                } else {
+                    '-'
+                }
+            })
+            .collect(),
+    };
+    let password = match &cli.password_file {
+        Some(path) => Some(
+            std::fs::read_to_string(path)
+                .with_context(|| format!("reading the password file {}", path.display()))?
+                .trim_end_matches(['\r', '\n'])
+                .to_owned(),
+        ),
+        None => None,
+    };
+    let tls = TlsFiles {
+        root_ca: cli.tls_root_ca,
+        certificate: cli.tls_certificate,
+        private_key: cli.tls_private_key,
+    };
+    tls.check_readable()?;
+    let logs = cli
+        .logs
+        .unwrap_or_else(|| std::env::temp_dir().join(format!("swarm-host-{name}")));
+    let options = HostOptions {
+        connect: cli.connect,
+        capacity: cli.capacity,
+        zenoh: ZenohOptions {
+            config_file: cli.zenoh_config,
+            lease: Duration::from_millis(cli.lease_ms),
+            user: cli.user,
+            password,
+            credentials_file: None,
+            tls,
+        },
+        max_payload: DEFAULT_MAX_PAYLOAD,
+        logs,
+        name,
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    host::serve(&options, &stop).with_context(|| format!("host '{}'", options.name))
+}
+
+/// `swarm experiment`: runs the batch, prints where its results are, and fails if any run failed.
+fn run_experiment(options: ExperimentOptions) -> anyhow::Result<()> {
+    // Find (under cargo: build) the world and agent programs once, rather than once per run from parallel threads.
+    let binaries = Binaries::locate().context("locating the world and agent programs")?;
+    if std::env::var_os("SWARM_BIN_DIR").is_none()
+        && let Some(dir) = binaries.world.parent()
+    {
+        // SAFETY: the process has one thread here; the Ctrl-C handler's thread and the runs start below.
+        unsafe { std::env::set_var("SWARM_BIN_DIR", dir) };
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    let report = experiment::run(&options, stop)
+        .with_context(|| format!("running the grid {}", options.grid.display()))?;
+    println!(
+        "{}: {} configurations, {} of {} runs finished ({} by earlier invocations), {} failed, {} at once; results \
+         in {}",
+        if report.interrupted {
+            "stopped"
+        } else {
+            "done"
+        },
+        report.configurations,
+        report.runs_reused + report.runs_completed,
+        report.runs_planned,
+        report.runs_reused,
+        report.failures.len(),
+        report.jobs,
+        report.dir.join("results.csv").display()
+    );
+    if let Some(reason) = &report.plots_missing {
+        eprintln!("warning: no figures: {reason}");
+    }
+    if report.interrupted {
+        println!("run the same command again to continue");
+    }
+    anyhow::ensure!(
+        report.failures.is_empty(),
+        "{} run(s) failed:\n{}",
+        report.failures.len(),
+        report.failures.join("\n")
+    );
+    Ok(())
+}

@@ -1,0 +1,766 @@
+//! The launcher behind `swarm run`: validates an experiment, starts the world process and one robot-agent
+//! process per robot, supervises them, and leaves a complete run directory and no shared-memory files behind.
+//!
+//! It never simulates or controls anything itself: the world and the agents are separate programs
+//! ([`binaries`]) that speak the [`process_args`] and [`world_report`] contracts with it.
+//!
+//! Order of a run: load and validate the configuration (all errors at once, located) -> resolve seed, ticks and
+//! robots -> create the run directory -> start the world (it creates every shared-memory service with limits
+//! for N robots and says `ready`) -> start the agents -> follow the world's tick reports on a progress bar; an agent
+//! that dies is reported to the world at once on its standard input (`dead <robot>`) -> when the world says
+//! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory.
+//!
+//! Faults (docs/faults.md): the world paces the schedule and reports each due fault between two ticks; the
+//! launcher applies it to the processes ([`fault_handling`]), restarts agents by their [`restart`] policy, and
+//! takes `swarm ctl` requests on the run's [`control`] socket. If the world dies, the launcher stops every agent,
+//! cuts the records back to the last complete tick ([`records`]), writes the summary and fails with the reason.
+
+mod agents;
+pub mod control;
+mod fault_handling;
+pub mod fault_log;
+pub mod records;
+pub mod restart;
+
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use nix::sys::signal::Signal;
+
+use agents::{AgentSpawner, RobotEntry};
+use control::ControlServer;
+use fault_log::FaultRecord;
+use restart::RestartTracker;
+use swarm_contract::config::faults::{FaultKind, FaultSchedule};
+use swarm_contract::config::{ConfigErrors, Experiment};
+use swarm_contract::fault_plan::FaultPlan;
+use swarm_contract::process::binaries::{Binaries, BinariesError};
+use swarm_contract::process::children;
+use swarm_contract::process::children::Children;
+use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs};
+use swarm_contract::protocol::launcher_to_world::WorldArgs;
+use swarm_contract::protocol::launcher_to_world::WorldCommand;
+use swarm_contract::protocol::world_to_launcher::WorldReport;
+use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE};
+use swarm_contract::transport::{self, RunSpec};
+use swarm_remote::plan::{HostsArgs, HostsError, HostsPlan};
+
+/// How long the launcher waits for the world to create its services.
+const WORLD_READY_TIMEOUT: Duration = Duration::from_secs(60);
+/// How often the supervision loop looks at its children when the world is quiet.
+const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
+/// Lines of an agent's log quoted when it fails to start.
+const LOG_LINES_QUOTED: usize = 8;
+
+/// How long a run waits for its agents, or its hosts, to join before it gives up.
+pub const DEFAULT_JOIN_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// What `swarm run` was asked to do.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// The experiment configuration.
+    pub config: PathBuf,
+    /// Number of robots, overriding the configuration's e-puck `<distribute>` quantity.
+    pub robots: Option<u32>,
+    /// Ticks to run, overriding the configuration's `length`.
+    pub ticks: Option<u64>,
+    /// Run seed, overriding the configuration's `random_seed`.
+    pub seed: Option<u64>,
+    /// Run directory (default `runs/<config name>-<unix seconds>`).
+    pub out: Option<PathBuf>,
+    /// Show a progress bar on the terminal.
+    pub progress: bool,
+    /// How long a tick waits for a missing command (default: the transport's).
+    pub tick_deadline: Option<Duration>,
+    /// How long the run waits for its agents or hosts to join (default [`DEFAULT_JOIN_TIMEOUT`]).
+    pub join_timeout: Option<Duration>,
+    /// Pace the ticks at the configuration's ticks_per_second (real-time mode) instead of running flat out.
+    pub real_time: bool,
+    /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
+    pub faults: Vec<String>,
+    /// Hosts to run the robots on instead of locally (see [`hosts`]).
+    pub hosts: HostsArgs,
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    /// The run directory.
+    pub out_dir: PathBuf,
+    /// The seed used.
+    pub seed: u64,
+    /// Number of robots.
+    pub robots: u32,
+    /// Ticks completed.
+    pub ticks: u64,
+    /// Wall time from the start of the world to the end of the run, in seconds.
+    pub wall_seconds: f64,
+    /// Wall time from the start of the world to the first completed tick, in seconds.
+    pub time_to_first_tick_seconds: f64,
+    /// Whether the run was stopped early by Ctrl-C.
+    pub interrupted: bool,
+    /// Robots whose agent died during the run, with the tick the world had completed at the time.
+    pub deaths: Vec<Death>,
+    /// Process id of the world.
+    pub world_pid: u32,
+    /// Process id of each robot's (first) agent, by robot index.
+    pub agent_pids: Vec<u32>,
+    /// Every fault of the run, in the order the launcher learnt of them.
+    pub faults: Vec<FaultRecord>,
+    /// Robots taking part when the run ended.
+    pub alive_final: u32,
+}
+
+/// An agent that died while the run went on.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Death {
+    /// Robot index.
+    pub robot: u32,
+    /// Last tick the world had completed when the launcher saw the death.
+    pub after_tick: u64,
+    /// How the process ended.
+    pub status: String,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LaunchError {
+    /// The configuration is invalid.
+    #[error("{0}")]
+    Config(#[from] ConfigErrors),
+    /// The configuration has no robot to run.
+    #[error("{path}: the arena has no e-puck, so there is nothing to run")]
+    NoRobots {
+        /// The configuration.
+        path: PathBuf,
+    },
+    /// The world or agent programs are missing.
+    #[error(transparent)]
+    Binaries(#[from] BinariesError),
+    /// The hosts of the run cannot be resolved.
+    #[error(transparent)]
+    Hosts(#[from] HostsError),
+    /// A file or process operation failed.
+    #[error("{what}: {source}")]
+    Io {
+        /// What the launcher was doing.
+        what: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The world process ended before it was ready or before the experiment finished.
+    #[error("the world process ended ({status}) {when}")]
+    WorldDied {
+        /// Exit status.
+        status: String,
+        /// At which point of the run.
+        when: String,
+    },
+    /// The world did not say `ready` in time.
+    #[error("the world process did not create its services within {0:?}")]
+    WorldNotReady(Duration),
+    /// An agent failed before the first tick.
+    #[error("robot {robot} ({id}) failed to start ({status}):\n{log}")]
+    AgentFailed {
+        /// Robot index.
+        robot: u32,
+        /// Robot id from the configuration.
+        id: String,
+        /// Exit status.
+        status: String,
+        /// The end of the agent's log.
+        log: String,
+    },
+}
+
+fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> LaunchError {
+    let what = what.into();
+    move |source| LaunchError::Io { what, source }
+}
+
+/// Removes every shared-memory file of a run when dropped, whatever happened before.
+struct SharedMemoryGuard(RunSpec);
+
+impl Drop for SharedMemoryGuard {
+    fn drop(&mut self) {
+        if let Err(e) = self.0.cleanup() {
+            tracing::warn!("removing the run's shared memory: {e}");
+        }
+    }
+}
+
+/// Runs one experiment to its end; `stop` set (e.g. by Ctrl-C) ends it early and cleanly.
+pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, LaunchError> {
+    let (experiment, warnings) = Experiment::load(&options.config)?;
+    for warning in &warnings {
+        tracing::warn!("{warning}");
+    }
+    let experiment = match options.robots {
+        Some(n) => experiment.with_robot_count(n)?,
+        None => experiment,
+    };
+    let roster = experiment.arena.robots();
+    if roster.is_empty() {
+        return Err(LaunchError::NoRobots {
+            path: options.config.clone(),
+        });
+    }
+    let robots = roster.len() as u32;
+    let seed = options
+        .seed
+        .or(experiment.framework.random_seed)
+        .unwrap_or_else(clock_seed);
+    if options.seed.is_none() && experiment.framework.random_seed.is_none() {
+        tracing::warn!(
+            seed,
+            "no random_seed in the configuration: using one from the clock"
+        );
+    }
+    let ticks = options
+        .ticks
+        .or(experiment.framework.max_ticks())
+        .unwrap_or(0);
+    let placement =
+        HostsPlan::resolve(&options.config, &options.hosts)?.map(|plan| plan.place(robots));
+    let out_dir = run_dir::create(options.out.as_deref(), &options.config)
+        .map_err(io("creating the run directory"))?;
+    let binaries = Binaries::locate()?;
+    let spec = RunSpec::unique();
+    let _shared_memory = SharedMemoryGuard(spec.clone());
+    let run_args = RunArgs {
+        run: spec.name().to_owned(),
+        iox_root: spec.root_dir().to_path_buf(),
+    };
+    let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
+    let controller_ids: Vec<&str> = experiment
+        .controllers
+        .iter()
+        .map(|c| c.id.as_str())
+        .collect();
+    let schedule = FaultSchedule::load(&options.config, &options.faults, robots, &controller_ids)?;
+    let ticks_per_second = experiment.framework.ticks_per_second;
+    let mut startup = Vec::new();
+    FaultPlan::new(&schedule, ticks_per_second, seed).due(
+        0,
+        &vec![true; roster.len()],
+        &mut startup,
+    );
+    tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
+
+    let compiled = check_controllers(
+        &binaries,
+        &run_args,
+        &config,
+        seed,
+        options.robots,
+        &roster,
+        &out_dir,
+    )?;
+
+    let started = Instant::now();
+    let mut children = Children::default();
+    let world_args = WorldArgs {
+        run: run_args.clone(),
+        config: config.clone(),
+        seed,
+        ticks,
+        robots: options.robots,
+        out: out_dir.clone(),
+        tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
+        join_timeout_ms: options
+            .join_timeout
+            .unwrap_or(DEFAULT_JOIN_TIMEOUT)
+            .as_millis() as u64,
+        real_time: options.real_time,
+        faults: options.faults.clone(),
+    };
+    let mut world = children::spawn(
+        Command::new(&binaries.world)
+            .args(world_args.to_args())
+            .args(options.hosts.to_args())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped()),
+    )
+    .map_err(io(format!("starting {}", binaries.world.display())))?;
+    let world_pid = world.id();
+    let world_stdin = world.stdin.take();
+    let reports = follow_reports(world.stdout.take());
+    children.world = Some(world);
+
+    wait_ready(&mut children, &reports, robots)?;
+    // With hosts, each host daemon starts its own robots' agents; the world waits for them.
+    if let Some(placement) = &placement {
+        for share in placement {
+            tracing::info!(host = share.name, robots = share.robots.len(), "placed");
+        }
+    }
+    let control = match ControlServer::listen(&out_dir) {
+        Ok(server) => Some(server),
+        Err(e) => {
+            tracing::warn!(
+                "no `swarm ctl` for this run: cannot listen in {}: {e}",
+                out_dir.display()
+            );
+            None
+        }
+    };
+    let spawner = AgentSpawner {
+        program: binaries.agent.clone(),
+        run: run_args.clone(),
+        config: config.clone(),
+        seed,
+        robots: options.robots,
+        out_dir: out_dir.clone(),
+        compiled,
+    };
+    let progress = progress_bar(options.progress, ticks, robots);
+    let mut supervision = Supervision {
+        children,
+        world_stdin,
+        roster_ids: roster.iter().map(|r| r.id.clone()).collect(),
+        out_dir: out_dir.clone(),
+        progress,
+        started,
+        run: spec.clone(),
+        first_tick: None,
+        last_tick: 0,
+        deaths: Vec::new(),
+        interrupted: false,
+        robots: roster
+            .iter()
+            .map(|r| {
+                RobotEntry::new(
+                    r.epuck.controller.clone(),
+                    RestartTracker::new(
+                        schedule.restart_rule(r.index, &r.epuck.controller).cloned(),
+                    ),
+                )
+            })
+            .collect(),
+        spawner,
+        ticks_per_second,
+        faults: Vec::new(),
+        pending_restarts: Vec::new(),
+        reaped: Vec::new(),
+        host_names: placement
+            .iter()
+            .flatten()
+            .map(|share| share.name.clone())
+            .collect(),
+        control,
+    };
+    if placement.is_none() {
+        supervision.start_agents(&startup)?;
+    }
+    // Robots on hosts (and robots killed before they started) have no local process.
+    let agent_pids: Vec<u32> = supervision
+        .robots
+        .iter()
+        .map(|r| r.first_pid)
+        .filter(|&pid| pid != 0)
+        .collect();
+    let followed = supervision.follow(&reports, &stop);
+    if let Err(error) = followed {
+        supervision.children.kill_all();
+        supervision.progress.finish_and_clear();
+        if matches!(error, LaunchError::WorldDied { .. }) {
+            let complete = records::trim_to_complete_ticks(&out_dir, robots)
+                .map_err(io("cutting the records back to the last complete tick"))?;
+            let report =
+                supervision.report(seed, robots, world_pid, agent_pids, complete.unwrap_or(0));
+            complete_summary(&out_dir, &report, Some(&error.to_string()))?;
+        }
+        return Err(error);
+    }
+    supervision.collect_agents();
+    supervision.progress.finish_and_clear();
+    let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
+    complete_summary(&out_dir, &report, None)?;
+    Ok(report)
+}
+
+/// Builds every controller of the run once, before any process of the run starts (`robot-agent --check` for the
+/// first robot of each controller), so a missing callback or a bad supervisor file fails the run at once with the
+/// agent's reason; records each controller's event names in [`EVENT_TABLES_FILE`]. The check also compiles each
+/// supervised controller's models once, into `supervisors/<controller>.ptsct` of the run directory; returns those
+/// files by controller id, for the agents to load instead of synthesising the models again.
+fn check_controllers(
+    binaries: &Binaries,
+    run_args: &RunArgs,
+    config: &Path,
+    seed: u64,
+    robots: Option<u32>,
+    roster: &[swarm_contract::config::Robot<'_>],
+    out_dir: &Path,
+) -> Result<HashMap<String, PathBuf>, LaunchError> {
+    let compiled_dir = out_dir.join(COMPILED_SUPERVISORS_DIR);
+    std::fs::create_dir_all(&compiled_dir)
+        .map_err(io(format!("creating {}", compiled_dir.display())))?;
+    let mut compiled = HashMap::new();
+    let mut tables = serde_json::Map::new();
+    for robot in roster {
+        let controller = &robot.epuck.controller;
+        if tables.contains_key(controller) {
+            continue;
+        }
+        let mut args = AgentArgs::launched(run_args, robot.index, config, controller, seed);
+        args.robots = robots;
+        let compiled_file = run_dir::compiled_supervisors(out_dir, controller);
+        let output = Command::new(&binaries.agent)
+            .args(args.to_args())
+            .arg("--check")
+            .arg("--write-supervisors")
+            .arg(&compiled_file)
+            .stdin(Stdio::null())
+            .output()
+            .map_err(io(format!("starting {}", binaries.agent.display())))?;
+        if !output.status.success() {
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+            return Err(LaunchError::AgentFailed {
+                robot: robot.index,
+                id: robot.id.clone(),
+                status: output.status.to_string(),
+                log: lines[lines.len().saturating_sub(LOG_LINES_QUOTED)..].join("\n"),
+            });
+        }
+        let names: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap_or_default();
+        tables.insert(controller.clone(), names);
+        // Native controllers have no supervisors: no file, and their agents get no flag.
+        if compiled_file.is_file() {
+            compiled.insert(controller.clone(), compiled_file);
+        }
+    }
+    let path = out_dir.join(EVENT_TABLES_FILE);
+    let text = serde_json::to_string_pretty(&serde_json::Value::Object(tables)).unwrap_or_default();
+    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))?;
+    Ok(compiled)
+}
+
+/// A seed from the clock, for configurations that ask for one.
+fn clock_seed() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(1, |d| d.as_nanos() as u64)
+        .max(1)
+}
+
+/// Reads the world's reports on a thread so the launcher can wait on them with timeouts.
+fn follow_reports(stdout: Option<std::process::ChildStdout>) -> Receiver<WorldReport> {
+    let (sender, receiver) = mpsc::channel();
+    if let Some(stdout) = stdout {
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines() {
+                let Ok(line) = line else { break };
+                if let Some(report) = WorldReport::parse(&line)
+                    && sender.send(report).is_err()
+                {
+                    break;
+                }
+            }
+        });
+    }
+    receiver
+}
+
+/// Waits for the world's `ready`, failing early if it dies.
+fn wait_ready(
+    children: &mut Children,
+    reports: &Receiver<WorldReport>,
+    robots: u32,
+) -> Result<(), LaunchError> {
+    let deadline = Instant::now() + WORLD_READY_TIMEOUT;
+    loop {
+        match reports.recv_timeout(SUPERVISION_PERIOD) {
+            Ok(WorldReport::Ready { robots: ready }) if ready == robots => return Ok(()),
+            Ok(WorldReport::Ready { robots: ready }) => {
+                return Err(LaunchError::WorldDied {
+                    status: format!("ready for {ready} robots"),
+                    when: format!("while the launcher expected {robots}"),
+                });
+            }
+            // A closed channel means the world is exiting; its status below says how.
+            Ok(_) | Err(_) => {}
+        }
+        if let Some(world) = children.world.as_mut()
+            && let Ok(Some(status)) = world.try_wait()
+        {
+            children.world = None;
+            return Err(LaunchError::WorldDied {
+                status: status.to_string(),
+                when: "before it was ready (its error is above)".into(),
+            });
+        }
+        if Instant::now() > deadline {
+            return Err(LaunchError::WorldNotReady(WORLD_READY_TIMEOUT));
+        }
+    }
+}
+
+fn progress_bar(visible: bool, ticks: u64, robots: u32) -> ProgressBar {
+    if !visible {
+        return ProgressBar::hidden();
+    }
+    let bar = if ticks > 0 {
+        ProgressBar::new(ticks)
+    } else {
+        ProgressBar::new_spinner()
+    };
+    let template = if ticks > 0 {
+        "{elapsed_precise} [{bar:40}] tick {pos}/{len} {per_sec} {msg}"
+    } else {
+        "{elapsed_precise} {spinner} tick {pos} {per_sec} {msg}"
+    };
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(format!("{robots}/{robots} robots alive"));
+    bar
+}
+
+/// The launcher's view of a running experiment.
+struct Supervision {
+    children: Children,
+    /// The run, to tell an agent that exits with it from one that exits before it.
+    run: RunSpec,
+    world_stdin: Option<ChildStdin>,
+    roster_ids: Vec<String>,
+    out_dir: PathBuf,
+    progress: ProgressBar,
+    started: Instant,
+    first_tick: Option<Instant>,
+    last_tick: u64,
+    deaths: Vec<Death>,
+    interrupted: bool,
+    /// Per robot: its agent's process, state and restart history.
+    robots: Vec<RobotEntry>,
+    spawner: AgentSpawner,
+    ticks_per_second: u32,
+    faults: Vec<FaultRecord>,
+    /// Replacement agents to start once their backoff has passed (robot, when).
+    pending_restarts: Vec<(u32, Instant)>,
+    /// Agents the launcher killed and reaped itself (`swarm ctl kill`), whose exit is still to be handled.
+    reaped: Vec<(u32, ExitStatus)>,
+    /// The hosts of a multi-host run, in placement order (empty for a local run).
+    host_names: Vec<String>,
+    control: Option<ControlServer>,
+}
+
+impl Supervision {
+    /// Follows the run until the world finishes (or is stopped and finishes), handling deaths, faults,
+    /// restarts and `swarm ctl` requests on the way.
+    fn follow(
+        &mut self,
+        reports: &Receiver<WorldReport>,
+        stop: &AtomicBool,
+    ) -> Result<(), LaunchError> {
+        let mut stop_sent = false;
+        loop {
+            if stop.load(Ordering::Relaxed) && !stop_sent {
+                stop_sent = true;
+                self.interrupted = true;
+                tracing::info!("stopping: the world finishes its tick and flushes its records");
+                self.thaw_all();
+                if let Some(world) = &self.children.world {
+                    children::signal(world, Signal::SIGTERM);
+                }
+            }
+            match reports.recv_timeout(SUPERVISION_PERIOD) {
+                Ok(WorldReport::Tick { tick, dead, .. }) => {
+                    if self.first_tick.is_none() {
+                        self.first_tick = Some(Instant::now());
+                        tracing::info!(after = ?self.started.elapsed(), "first tick completed");
+                    }
+                    self.last_tick = tick;
+                    self.progress.set_position(tick);
+                    let total = self.roster_ids.len() as u32;
+                    self.progress.set_message(format!(
+                        "{}/{total} robots alive",
+                        total.saturating_sub(dead)
+                    ));
+                }
+                Ok(WorldReport::Finished { ticks }) => {
+                    self.last_tick = ticks;
+                    self.wait_world()?;
+                    return Ok(());
+                }
+                Ok(WorldReport::Fault { tick, kind, robot }) => {
+                    self.on_fault(tick, kind, robot)?;
+                    if kind == FaultKind::KillWorld {
+                        return self.world_killed(tick);
+                    }
+                }
+                Ok(WorldReport::Await { tick }) => self.send_world(WorldCommand::Applied(tick)),
+                Ok(WorldReport::Down { tick, robot, cause }) => self.on_down(tick, robot, cause),
+                Ok(WorldReport::Up { tick, robot }) => self.on_up(tick, robot),
+                Ok(WorldReport::Ready { .. }) | Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => {
+                    // The world closed its output: it is exiting; its status says how.
+                    self.wait_world()?;
+                    return Err(LaunchError::WorldDied {
+                        status: "without reporting the end of the experiment".into(),
+                        when: format!("after tick {}", self.last_tick),
+                    });
+                }
+            }
+            self.answer_control();
+            self.handle_agent_exits()?;
+            self.start_due_restarts()?;
+        }
+    }
+
+    /// Sends one line to the world (a world that is gone is noticed by the report loop).
+    fn send_world(&mut self, command: WorldCommand) {
+        if let Some(stdin) = self.world_stdin.as_mut() {
+            let _ = writeln!(stdin, "{command}");
+        }
+    }
+
+    /// Reaps exited agents (and takes those `swarm ctl kill` reaped): before the first tick an exit is a failed
+    /// start; afterwards an exit is a death the world hears of at once, unless the agent exited 0 with the run.
+    fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
+        let mut exits = std::mem::take(&mut self.reaped);
+        exits.extend(self.children.reap_agents());
+        for (robot, status) in exits {
+            if self.first_tick.is_none() && !self.robots[robot as usize].ctl_killed {
+                let log =
+                    run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
+                return Err(LaunchError::AgentFailed {
+                    robot,
+                    id: self
+                        .roster_ids
+                        .get(robot as usize)
+                        .cloned()
+                        .unwrap_or_default(),
+                    status: status.to_string(),
+                    log,
+                });
+            }
+            // Agents exit 0 when the world has ended the run (its `finished` report may still be queued), and
+            // when they are asked to stop (SIGTERM): that robot leaves the run, and only `always` restarts it.
+            if status.success() && (self.interrupted || transport::run_ended(&self.run)) {
+                continue;
+            }
+            if status.success() {
+                tracing::warn!(robot, tick = self.last_tick, "robot agent left the run");
+            } else {
+                tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
+            }
+            self.send_world(WorldCommand::Dead(robot));
+            self.deaths.push(Death {
+                robot,
+                after_tick: self.last_tick,
+                status: status.to_string(),
+            });
+            self.on_exit(robot, status);
+        }
+        Ok(())
+    }
+
+    /// Waits for the world to exit and checks it succeeded.
+    fn wait_world(&mut self) -> Result<(), LaunchError> {
+        let Some(mut world) = self.children.world.take() else {
+            return Ok(());
+        };
+        let status = world.wait().map_err(io("waiting for the world process"))?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(LaunchError::WorldDied {
+                status: status.to_string(),
+                when: format!("after tick {}", self.last_tick),
+            })
+        }
+    }
+
+    /// Lets agents exit by themselves (the world's end tells them), then kills the rest.
+    fn collect_agents(&mut self) {
+        self.thaw_all();
+        let stragglers = self.children.end_agents(SUPERVISION_PERIOD);
+        if stragglers > 0 {
+            tracing::warn!(stragglers, "agents did not exit after the run; killed them");
+        }
+    }
+
+    /// What the run did, for `summary.json` and the caller.
+    fn report(
+        &self,
+        seed: u64,
+        robots: u32,
+        world_pid: u32,
+        agent_pids: Vec<u32>,
+        ticks: u64,
+    ) -> RunReport {
+        RunReport {
+            out_dir: self.out_dir.clone(),
+            seed,
+            robots,
+            ticks,
+            wall_seconds: self.started.elapsed().as_secs_f64(),
+            time_to_first_tick_seconds: self
+                .first_tick
+                .map_or(0.0, |t| t.duration_since(self.started).as_secs_f64()),
+            interrupted: self.interrupted,
+            deaths: self.deaths.clone(),
+            world_pid,
+            agent_pids,
+            faults: self.faults.clone(),
+            alive_final: self.robots.iter().filter(|r| r.is_alive()).count() as u32,
+        }
+    }
+}
+
+/// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none, e.g. because
+/// it died: `world_died` then says why).
+fn complete_summary(
+    out_dir: &Path,
+    report: &RunReport,
+    world_died: Option<&str>,
+) -> Result<(), LaunchError> {
+    let path = out_dir.join(run_dir::SUMMARY_FILE);
+    let mut summary = std::fs::read_to_string(&path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .filter(serde_json::Value::is_object)
+        .unwrap_or_else(|| serde_json::json!({}));
+    let deaths: Vec<serde_json::Value> = report
+        .deaths
+        .iter()
+        .map(|d| serde_json::json!({"robot": d.robot, "after_tick": d.after_tick, "status": d.status}))
+        .collect();
+    if let Some(object) = summary.as_object_mut() {
+        object.insert("seed".into(), report.seed.into());
+        object.insert("robots".into(), report.robots.into());
+        object.insert("ticks".into(), report.ticks.into());
+        object.insert("wall_seconds".into(), report.wall_seconds.into());
+        object.insert(
+            "time_to_first_tick_seconds".into(),
+            report.time_to_first_tick_seconds.into(),
+        );
+        object.insert("interrupted".into(), report.interrupted.into());
+        object.insert("deaths".into(), deaths.into());
+        object.insert(
+            "processes".into(),
+            serde_json::json!({"world": report.world_pid, "agents": report.agent_pids}),
+        );
+        let faults: Vec<serde_json::Value> =
+            report.faults.iter().map(FaultRecord::to_json).collect();
+        object.insert("faults".into(), faults.into());
+        object
+            .entry("alive_final")
+            .or_insert(report.alive_final.into());
+        if let Some(reason) = world_died {
+            object.insert("world_died".into(), reason.into());
+        }
+    }
+    let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    std::fs::write(&path, text + "\n").map_err(io(format!("writing {}", path.display())))
+}

@@ -1,0 +1,828 @@
+//! `<arena>`: entities (box, cylinder, e-puck, light, our target), the floor, and `<distribute>` blocks.
+
+use super::{Ctx, MediumRef};
+use crate::config::model::{
+    Arena, BoxEntity, CylinderEntity, Distribute, EPuckEntity, Element, Entity, Euler, Floor,
+    FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose,
+    PositionMethod, TargetEntity, Vec3,
+};
+use crate::config::registry::MediumKind;
+use crate::config::suggest::did_you_mean;
+use crate::messages::Rgb;
+
+const ENTITIES: &[&str] = &["box", "cylinder", "e-puck", "light", "target"];
+const ARENA_CHILDREN: &[&str] = &[
+    "box",
+    "cylinder",
+    "e-puck",
+    "light",
+    "target",
+    "floor",
+    "distribute",
+];
+/// ARGoS entities we recognise but do not simulate.
+const UNSUPPORTED_ENTITIES: &[&str] = &[
+    "foot-bot",
+    "eye-bot",
+    "spiri",
+    "kheperaiv",
+    "pi-puck",
+    "builderbot",
+    "drone",
+    "prototype",
+    "block",
+];
+/// Height of the e-puck omnidirectional camera (docs/epuck-and-world.md 1.5): LEDs at or above it are never seen.
+const CAMERA_HEIGHT: f64 = 0.122;
+/// Default LED height of a `<target>` (docs/tasks.md 4.9: a red LED at 0.06 m).
+const TARGET_LED_HEIGHT: f64 = 0.06;
+/// Default floor resolution when `pixels_per_meter` is absent.
+const PIXELS_PER_METER: f64 = 50.0;
+
+/// Parses `<arena size center>`.
+pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
+    ctx.unknown_attributes(el, &["size", "center", "positional_grid_size"]);
+    if let Some(grid) = el.attributes.get("positional_grid_size") {
+        ctx.warn(
+            grid.location,
+            "'positional_grid_size' is ignored: the world indexes space itself",
+            None,
+        );
+    }
+    let size: Option<Vec3> = ctx.required(el, "size");
+    if let Some(s) = size
+        && (s.x <= 0.0 || s.y <= 0.0)
+    {
+        let at = el
+            .attributes
+            .get("size")
+            .map_or(el.location, |a| a.location);
+        ctx.error(
+            at,
+            format!("arena 'size' must be positive in x and y, got {s}"),
+            None,
+        );
+    }
+    let center: Vec3 = ctx.attr(el, "center").unwrap_or_default();
+    let mut floor: Option<Floor> = None;
+    let mut entities = Vec::new();
+    let mut distributions = Vec::new();
+    for child in &el.children {
+        match child.name.as_str() {
+            "floor" => {
+                if let Some(first) = &floor {
+                    ctx.duplicate(child, &el.name, first.location);
+                    continue;
+                }
+                floor = parse_floor(ctx, child);
+            }
+            "distribute" => distributions.extend(distribute(ctx, child)),
+            name if ENTITIES.contains(&name) => entities.extend(placed(ctx, child)),
+            name if UNSUPPORTED_ENTITIES.contains(&name) => {
+                ctx.error(
+                    child.location,
+                    format!("entity <{name}> is not supported: the world simulates e-pucks"),
+                    None,
+                );
+            }
+            _ => ctx.unknown_element(child, &el.name, ARENA_CHILDREN),
+        }
+    }
+    Some(Arena {
+        size: size?,
+        center,
+        floor,
+        entities,
+        distributions,
+        location: el.location,
+    })
+}
+
+/// A hand-placed entity: its pose comes from `<body>` (lights: their own attributes).
+fn placed(ctx: &mut Ctx, el: &Element) -> Option<PlacedEntity> {
+    let (pose, entity) = entity(ctx, el, true);
+    Some(PlacedEntity {
+        pose: pose?,
+        entity: entity?,
+    })
+}
+
+/// Parses an entity. Hand-placed entities need a pose; distribution templates must not have one.
+fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<Entity>) {
+    let mut pose = None;
+    let entity = match el.name.as_str() {
+        "light" => {
+            pose = light_pose(ctx, el, placed);
+            light(ctx, el).map(Entity::Light)
+        }
+        name => {
+            let children: &[&str] = match name {
+                "box" | "cylinder" => &["body", "leds"],
+                "e-puck" => &["body", "controller"],
+                _ => &["body"],
+            };
+            let mut body: Option<&Element> = None;
+            for child in &el.children {
+                if !children.contains(&child.name.as_str()) {
+                    ctx.unknown_element(child, &el.name, children);
+                } else if child.name == "body" {
+                    match body {
+                        Some(first) => ctx.duplicate(child, &el.name, first.location),
+                        None => body = Some(child),
+                    }
+                }
+            }
+            match (body, placed) {
+                (Some(b), true) => pose = parse_body(ctx, b),
+                (None, true) => ctx.error(
+                    el.location,
+                    format!("<{name}> placed by hand needs a <body position=\"x,y,z\" orientation=\"z,y,x\"/>"),
+                    None,
+                ),
+                (Some(b), false) => ctx.error(
+                    b.location,
+                    format!("<body> is not allowed in a <distribute> template: <position> and <orientation> place each <{name}>"),
+                    None,
+                ),
+                (None, false) => {}
+            }
+            match name {
+                "box" => box_entity(ctx, el).map(Entity::Box),
+                "cylinder" => cylinder(ctx, el).map(Entity::Cylinder),
+                "e-puck" => epuck(ctx, el).map(Entity::EPuck),
+                _ => target(ctx, el).map(Entity::Target),
+            }
+        }
+    };
+    (pose, entity)
+}
+
+fn parse_body(ctx: &mut Ctx, el: &Element) -> Option<Pose> {
+    ctx.unknown_attributes(el, &["position", "orientation"]);
+    for child in &el.children {
+        ctx.unknown_element(child, &el.name, &[]);
+    }
+    let position: Vec3 = ctx.required(el, "position")?;
+    let orientation: Euler = ctx.attr(el, "orientation").unwrap_or_default();
+    Some(Pose {
+        position,
+        orientation,
+    })
+}
+
+/// `movable` (default false) and `mass`, which a movable entity must have.
+fn movable_mass(ctx: &mut Ctx, el: &Element) -> Option<(bool, Option<f64>)> {
+    let movable: bool = ctx.attr(el, "movable").unwrap_or(false);
+    if !movable {
+        if let Some(mass) = el.attributes.get("mass") {
+            ctx.warn(
+                mass.location,
+                format!("'mass' is ignored: this <{}> is not movable", el.name),
+                None,
+            );
+        }
+        return Some((false, None));
+    }
+    if !el.attributes.contains_key("mass") {
+        ctx.error(
+            el.location,
+            format!("a movable <{}> needs a 'mass' (kg)", el.name),
+            None,
+        );
+        return None;
+    }
+    ctx.positive(el, "mass").map(|m| (true, Some(m)))
+}
+
+fn box_entity(ctx: &mut Ctx, el: &Element) -> Option<BoxEntity> {
+    ctx.unknown_attributes(el, &["id", "size", "movable", "mass"]);
+    let id: Option<String> = ctx.required(el, "id");
+    let size: Option<Vec3> = ctx.required(el, "size");
+    let size = size.filter(|s| {
+        let ok = s.x > 0.0 && s.y > 0.0 && s.z > 0.0;
+        if !ok {
+            let at = el
+                .attributes
+                .get("size")
+                .map_or(el.location, |a| a.location);
+            ctx.error(
+                at,
+                format!("box 'size' must be positive in every component, got {s}"),
+                None,
+            );
+        }
+        ok
+    });
+    let movable = movable_mass(ctx, el);
+    let leds = led_group(ctx, el);
+    let (movable, mass) = movable?;
+    Some(BoxEntity {
+        id: id?,
+        size: size?,
+        movable,
+        mass,
+        leds: leds?,
+        location: el.location,
+    })
+}
+
+fn cylinder(ctx: &mut Ctx, el: &Element) -> Option<CylinderEntity> {
+    ctx.unknown_attributes(el, &["id", "radius", "height", "movable", "mass"]);
+    let id: Option<String> = ctx.required(el, "id");
+    let radius = ctx.positive(el, "radius");
+    let height = ctx.positive(el, "height");
+    let movable = movable_mass(ctx, el);
+    let leds = led_group(ctx, el);
+    let (movable, mass) = movable?;
+    Some(CylinderEntity {
+        id: id?,
+        radius: radius?,
+        height: height?,
+        movable,
+        mass,
+        leds: leds?,
+        location: el.location,
+    })
+}
+
+/// The optional `<leds medium>` child: `Some(None)` when absent, `None` on error.
+fn led_group(ctx: &mut Ctx, parent: &Element) -> Option<Option<LedGroup>> {
+    let mut groups = parent.children.iter().filter(|c| c.name == "leds");
+    let Some(el) = groups.next() else {
+        return Some(None);
+    };
+    if let Some(second) = groups.next() {
+        ctx.duplicate(second, &parent.name, el.location);
+        return None;
+    }
+    ctx.unknown_attributes(el, &["medium"]);
+    let medium = medium_ref(
+        ctx,
+        el,
+        MediumKind::Led,
+        format!("<leds> of <{}>", parent.name),
+    );
+    let mut leds = Vec::new();
+    let (children, mut ok) = ctx.children_named(el, "led");
+    for child in children {
+        ctx.unknown_attributes(child, &["offset", "anchor", "color"]);
+        let offset: Option<Vec3> = ctx.required(child, "offset");
+        let anchor: String = ctx
+            .attr(child, "anchor")
+            .unwrap_or_else(|| "origin".to_string());
+        let color: Option<Rgb> = ctx.required(child, "color");
+        match (offset, color) {
+            (Some(offset), Some(color)) => leds.push(Led {
+                offset,
+                anchor,
+                color,
+                location: child.location,
+            }),
+            _ => ok = false,
+        }
+    }
+    ok.then_some(())?;
+    Some(Some(LedGroup {
+        medium: medium?,
+        leds,
+        location: el.location,
+    }))
+}
+
+/// Reads a mandatory `medium` attribute and queues it for checking against `<media>`.
+fn medium_ref(ctx: &mut Ctx, el: &Element, kind: MediumKind, user: String) -> Option<String> {
+    let id: String = ctx.required(el, "medium")?;
+    let location = el
+        .attributes
+        .get("medium")
+        .map_or(el.location, |a| a.location);
+    ctx.medium_refs.push(MediumRef {
+        id: id.clone(),
+        kind,
+        location,
+        user,
+    });
+    Some(id)
+}
+
+fn epuck(ctx: &mut Ctx, el: &Element) -> Option<EPuckEntity> {
+    ctx.unknown_attributes(el, &["id", "rab_range", "rab_data_size"]);
+    let id: Option<String> = ctx.required(el, "id");
+    let rab_range: Option<f64> = ctx.attr(el, "rab_range");
+    let rab_range_ok = rab_range.is_none_or(|r| ctx.in_range(el, "rab_range", r, 0.0, None));
+    let rab_data_size: Option<u32> = ctx.attr(el, "rab_data_size");
+    let rab_data_size_ok = rab_data_size
+        .is_none_or(|d| ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(4.0)));
+    let mut controllers = el.children.iter().filter(|c| c.name == "controller");
+    let controller = match (controllers.next(), controllers.next()) {
+        (Some(c), None) => {
+            ctx.unknown_attributes(c, &["config"]);
+            ctx.required::<String>(c, "config")
+        }
+        (Some(first), Some(second)) => {
+            ctx.duplicate(second, &el.name, first.location);
+            None
+        }
+        (None, _) => {
+            ctx.error(
+                el.location,
+                "<e-puck> needs a <controller config=\"controller id\"/>",
+                None,
+            );
+            None
+        }
+    };
+    (rab_range_ok && rab_data_size_ok).then_some(())?;
+    Some(EPuckEntity {
+        id: id?,
+        controller: controller?,
+        rab_range,
+        rab_data_size,
+        location: el.location,
+    })
+}
+
+fn light_pose(ctx: &mut Ctx, el: &Element, placed: bool) -> Option<Pose> {
+    if !placed {
+        if let Some(position) = el.attributes.get("position") {
+            ctx.error(
+                position.location,
+                "'position' is not allowed on a <light> template: <distribute> places it",
+                None,
+            );
+        }
+        return None;
+    }
+    let position: Vec3 = ctx.required(el, "position")?;
+    let orientation: Euler = ctx.attr(el, "orientation").unwrap_or_default();
+    Some(Pose {
+        position,
+        orientation,
+    })
+}
+
+fn light(ctx: &mut Ctx, el: &Element) -> Option<LightEntity> {
+    ctx.unknown_attributes(
+        el,
+        &[
+            "id",
+            "position",
+            "orientation",
+            "color",
+            "intensity",
+            "medium",
+        ],
+    );
+    for child in &el.children {
+        ctx.unknown_element(child, &el.name, &[]);
+    }
+    let id: Option<String> = ctx.required(el, "id");
+    let color: Option<Rgb> = color(ctx, el, None);
+    let intensity = ctx.positive(el, "intensity");
+    let medium = medium_ref(ctx, el, MediumKind::Led, "<light>".to_string());
+    Some(LightEntity {
+        id: id?,
+        color: color?,
+        intensity: intensity?,
+        medium: medium?,
+        location: el.location,
+    })
+}
+
+/// A `color` attribute (mandatory unless a default is given), with a did-you-mean hint for colour names.
+fn color(ctx: &mut Ctx, el: &Element, default: Option<Rgb>) -> Option<Rgb> {
+    use crate::config::values::{Value, color_names};
+    let Some(attribute) = el.attributes.get("color") else {
+        if default.is_none() {
+            ctx.error(
+                el.location,
+                format!("<{}> is missing the attribute 'color'", el.name),
+                None,
+            );
+        }
+        return default;
+    };
+    match Rgb::parse_value(&attribute.value) {
+        Ok(rgb) => Some(rgb),
+        Err(reason) => {
+            let hint = did_you_mean(attribute.value.trim(), color_names());
+            ctx.error(
+                attribute.location,
+                format!("invalid 'color' in <{}>: {reason}", el.name),
+                hint,
+            );
+            None
+        }
+    }
+}
+
+fn target(ctx: &mut Ctx, el: &Element) -> Option<TargetEntity> {
+    ctx.unknown_attributes(
+        el,
+        &["id", "radius", "height", "color", "led_height", "medium"],
+    );
+    let id: Option<String> = ctx.required(el, "id");
+    let radius = ctx.positive(el, "radius");
+    let height = ctx.positive(el, "height");
+    let color = color(ctx, el, Some(Rgb { r: 255, g: 0, b: 0 }));
+    let led_height: f64 = ctx.attr(el, "led_height").unwrap_or(TARGET_LED_HEIGHT);
+    let led_ok = ctx.in_range(el, "led_height", led_height, 0.0, None);
+    if led_height >= CAMERA_HEIGHT {
+        let at = el
+            .attributes
+            .get("led_height")
+            .map_or(el.location, |a| a.location);
+        ctx.warn(
+            at,
+            format!("target LED at {led_height} m is not below the e-puck camera ({CAMERA_HEIGHT} m): cameras will not see it"),
+            None,
+        );
+    }
+    let medium = medium_ref(ctx, el, MediumKind::Led, "<target>".to_string());
+    led_ok.then_some(())?;
+    Some(TargetEntity {
+        id: id?,
+        radius: radius?,
+        height: height?,
+        color: color?,
+        led_height,
+        medium: medium?,
+        location: el.location,
+    })
+}
+
+const FLOOR_SOURCES: &[&str] = &["loop_functions", "image", "regions"];
+
+fn parse_floor(ctx: &mut Ctx, el: &Element) -> Option<Floor> {
+    ctx.unknown_attributes(el, &["id", "source", "pixels_per_meter", "path", "color"]);
+    let id: Option<String> = ctx.required(el, "id");
+    let source: Option<String> = ctx.required(el, "source");
+    let pixels_per_meter: f64 = ctx.attr(el, "pixels_per_meter").unwrap_or(PIXELS_PER_METER);
+    let ppm_ok = pixels_per_meter > 0.0 || {
+        let at = el
+            .attributes
+            .get("pixels_per_meter")
+            .map_or(el.location, |a| a.location);
+        ctx.error(
+            at,
+            format!("'pixels_per_meter' in <floor> must be greater than 0, got {pixels_per_meter}"),
+            None,
+        );
+        false
+    };
+    let source = match source.as_deref()? {
+        "regions" => regions(ctx, el)?,
+        other => {
+            for child in &el.children {
+                ctx.error(
+                    child.location,
+                    format!(
+                        "<{}> is not allowed in a <floor source=\"{other}\">",
+                        child.name
+                    ),
+                    (child.name == "region")
+                        .then(|| "use source=\"regions\" to paint regions".to_string()),
+                );
+            }
+            match other {
+                "loop_functions" => FloorSource::LoopFunctions,
+                "image" => FloorSource::Image {
+                    path: ctx.required(el, "path")?,
+                },
+                _ => {
+                    let at = el
+                        .attributes
+                        .get("source")
+                        .map_or(el.location, |a| a.location);
+                    let hint = did_you_mean(other, FLOOR_SOURCES.iter().copied());
+                    ctx.error(at, format!("unknown floor source '{other}' (expected loop_functions, image or regions)"), hint);
+                    return None;
+                }
+            }
+        }
+    };
+    ppm_ok.then_some(())?;
+    Some(Floor {
+        id: id?,
+        source,
+        pixels_per_meter,
+        location: el.location,
+    })
+}
+
+/// `<floor source="regions" color>` with `<region min max color>` children.
+fn regions(ctx: &mut Ctx, el: &Element) -> Option<FloorSource> {
+    let background = color(
+        ctx,
+        el,
+        Some(Rgb {
+            r: 255,
+            g: 255,
+            b: 255,
+        }),
+    );
+    let mut regions = Vec::new();
+    let (children, mut ok) = ctx.children_named(el, "region");
+    for child in children {
+        ctx.unknown_attributes(child, &["min", "max", "color"]);
+        let min = ctx.required(child, "min");
+        let max = ctx.required(child, "max");
+        let color = color(ctx, child, None);
+        let (Some(min), Some(max), Some(color)) = (min, max, color) else {
+            ok = false;
+            continue;
+        };
+        let (min, max): (crate::config::model::Vec2, crate::config::model::Vec2) = (min, max);
+        if min.x > max.x || min.y > max.y {
+            ctx.error(
+                child.location,
+                format!("<region> min '{min}' exceeds max '{max}'"),
+                None,
+            );
+            ok = false;
+            continue;
+        }
+        regions.push(FloorRegion {
+            min,
+            max,
+            color,
+            location: child.location,
+        });
+    }
+    ok.then_some(())?;
+    Some(FloorSource::Regions {
+        background: background?,
+        regions,
+    })
+}
+
+const DISTRIBUTE_CHILDREN: &[&str] = &["position", "orientation", "entity"];
+
+/// Parses `<distribute>`: exactly one `<position>`, `<orientation>` and `<entity>`.
+fn distribute(ctx: &mut Ctx, el: &Element) -> Option<Distribute> {
+    ctx.unknown_attributes(el, &[]);
+    let mut parts: [Option<&Element>; 3] = [None, None, None];
+    for child in &el.children {
+        match DISTRIBUTE_CHILDREN.iter().position(|n| *n == child.name) {
+            Some(i) => match parts[i] {
+                Some(first) => ctx.duplicate(child, &el.name, first.location),
+                None => parts[i] = Some(child),
+            },
+            None => ctx.unknown_element(child, &el.name, DISTRIBUTE_CHILDREN),
+        }
+    }
+    for (part, name) in parts.iter().zip(DISTRIBUTE_CHILDREN) {
+        if part.is_none() {
+            ctx.error(el.location, format!("<distribute> has no <{name}>"), None);
+        }
+    }
+    let [position_el, orientation_el, entity_el] = parts;
+    let position = position_el.and_then(|p| position_method(ctx, p));
+    let orientation = orientation_el.and_then(|o| orientation_method(ctx, o));
+    let entity_el = entity_el?;
+    ctx.unknown_attributes(entity_el, &["quantity", "max_trials", "base_num"]);
+    let quantity: Option<u32> = ctx.required(entity_el, "quantity");
+    let max_trials: Option<u32> = ctx.required(entity_el, "max_trials");
+    let base_num: u32 = ctx.attr(entity_el, "base_num").unwrap_or(0);
+    let template = match entity_el.children.as_slice() {
+        [one] if ENTITIES.contains(&one.name.as_str()) => entity(ctx, one, false).1,
+        [one] => {
+            let hint = did_you_mean(&one.name, ENTITIES.iter().copied());
+            ctx.error(
+                one.location,
+                format!("<{}> cannot be distributed", one.name),
+                hint,
+            );
+            None
+        }
+        children => {
+            ctx.error(
+                entity_el.location,
+                format!(
+                    "<entity> must contain exactly one entity template, found {}",
+                    children.len()
+                ),
+                None,
+            );
+            None
+        }
+    };
+    let (position, quantity) = (position?, quantity?);
+    if let PositionMethod::Grid { layout, .. } = &position {
+        let cells = layout.iter().map(|&n| u64::from(n)).product::<u64>();
+        if u64::from(quantity) > cells {
+            let at = entity_el
+                .attributes
+                .get("quantity")
+                .map_or(entity_el.location, |a| a.location);
+            ctx.error(
+                at,
+                format!(
+                    "quantity {quantity} exceeds the grid layout's {}x{}x{} = {cells} cells",
+                    layout[0], layout[1], layout[2]
+                ),
+                None,
+            );
+            return None;
+        }
+    }
+    Some(Distribute {
+        position,
+        orientation: orientation?,
+        quantity,
+        max_trials: max_trials?,
+        base_num,
+        template: template?,
+        location: el.location,
+        position_location: position_el.map_or(el.location, |p| p.location),
+        orientation_location: orientation_el.map_or(el.location, |o| o.location),
+        entity_location: entity_el.location,
+    })
+}
+
+const POSITION_METHODS: &[&str] = &["uniform", "gaussian", "constant", "grid"];
+const ORIENTATION_METHODS: &[&str] = &["uniform", "gaussian", "constant"];
+
+/// The `method` attribute, checked against `methods`.
+fn method<'a>(ctx: &mut Ctx, el: &'a Element, methods: &[&str]) -> Option<&'a str> {
+    let Some(attribute) = el.attributes.get("method") else {
+        ctx.error(
+            el.location,
+            format!("<{}> is missing the attribute 'method'", el.name),
+            None,
+        );
+        return None;
+    };
+    let method = attribute.value.trim();
+    if methods.contains(&method) {
+        return Some(method);
+    }
+    let hint = if method == "grid" {
+        Some("grid places positions only".to_string())
+    } else {
+        did_you_mean(method, methods.iter().copied())
+    };
+    ctx.error(
+        attribute.location,
+        format!(
+            "unknown {} method '{method}' (expected {})",
+            el.name,
+            methods.join(", ")
+        ),
+        hint,
+    );
+    None
+}
+
+fn position_method(ctx: &mut Ctx, el: &Element) -> Option<PositionMethod> {
+    let method = method(ctx, el, POSITION_METHODS)?;
+    let generator = match method {
+        "uniform" => {
+            ctx.unknown_attributes(el, &["method", "min", "max"]);
+            let (min, max) = (ctx.required(el, "min"), ctx.required(el, "max"));
+            let (min, max): (Vec3, Vec3) = (min?, max?);
+            uniform_bounds(
+                ctx,
+                el,
+                [min.x, min.y, min.z],
+                [max.x, max.y, max.z],
+                &min.to_string(),
+                &max.to_string(),
+            )?;
+            PositionMethod::Uniform { min, max }
+        }
+        "gaussian" => {
+            ctx.unknown_attributes(el, &["method", "mean", "std_dev"]);
+            let (mean, std_dev) = (ctx.required(el, "mean"), ctx.required(el, "std_dev"));
+            let (mean, std_dev): (Vec3, Vec3) = (mean?, std_dev?);
+            non_negative_std_dev(ctx, el, [std_dev.x, std_dev.y, std_dev.z])?;
+            PositionMethod::Gaussian { mean, std_dev }
+        }
+        "constant" => {
+            ctx.unknown_attributes(el, &["method", "values"]);
+            PositionMethod::Constant {
+                values: ctx.required(el, "values")?,
+            }
+        }
+        _ => {
+            ctx.unknown_attributes(el, &["method", "center", "distances", "layout"]);
+            let center = ctx.required(el, "center");
+            let distances = ctx.required(el, "distances");
+            let layout: Option<[u32; 3]> = ctx.required(el, "layout");
+            let layout = layout.filter(|l| {
+                let ok = l.iter().all(|&n| n >= 1);
+                if !ok {
+                    let at = el
+                        .attributes
+                        .get("layout")
+                        .map_or(el.location, |a| a.location);
+                    ctx.error(
+                        at,
+                        format!(
+                            "grid 'layout' needs at least 1 cell along each axis, got {},{},{}",
+                            l[0], l[1], l[2]
+                        ),
+                        None,
+                    );
+                }
+                ok
+            });
+            PositionMethod::Grid {
+                center: center?,
+                distances: distances?,
+                layout: layout?,
+            }
+        }
+    };
+    Some(generator)
+}
+
+fn orientation_method(ctx: &mut Ctx, el: &Element) -> Option<OrientationMethod> {
+    let method = method(ctx, el, ORIENTATION_METHODS)?;
+    let generator = match method {
+        "uniform" => {
+            ctx.unknown_attributes(el, &["method", "min", "max"]);
+            let (min, max) = (ctx.required(el, "min"), ctx.required(el, "max"));
+            let (min, max): (Euler, Euler) = (min?, max?);
+            let text = |e: Euler| format!("{},{},{}", e.z_deg, e.y_deg, e.x_deg);
+            uniform_bounds(
+                ctx,
+                el,
+                [min.z_deg, min.y_deg, min.x_deg],
+                [max.z_deg, max.y_deg, max.x_deg],
+                &text(min),
+                &text(max),
+            )?;
+            OrientationMethod::Uniform { min, max }
+        }
+        "gaussian" => {
+            ctx.unknown_attributes(el, &["method", "mean", "std_dev"]);
+            let (mean, std_dev) = (ctx.required(el, "mean"), ctx.required(el, "std_dev"));
+            let (mean, std_dev): (Euler, Euler) = (mean?, std_dev?);
+            non_negative_std_dev(ctx, el, [std_dev.z_deg, std_dev.y_deg, std_dev.x_deg])?;
+            OrientationMethod::Gaussian { mean, std_dev }
+        }
+        _ => {
+            ctx.unknown_attributes(el, &["method", "values"]);
+            OrientationMethod::Constant {
+                values: ctx.required(el, "values")?,
+            }
+        }
+    };
+    Some(generator)
+}
+
+/// `uniform` needs min <= max in every component (a component with min = max is constant).
+fn uniform_bounds(
+    ctx: &mut Ctx,
+    el: &Element,
+    min: [f64; 3],
+    max: [f64; 3],
+    min_text: &str,
+    max_text: &str,
+) -> Option<()> {
+    let axes = if el.name == "orientation" {
+        ["z", "y", "x"]
+    } else {
+        ["x", "y", "z"]
+    };
+    let bad: Vec<&str> = (0..3)
+        .filter(|&i| min[i] > max[i])
+        .map(|i| axes[i])
+        .collect();
+    if bad.is_empty() {
+        return Some(());
+    }
+    let at = el.attributes.get("min").map_or(el.location, |a| a.location);
+    ctx.error(
+        at,
+        format!(
+            "uniform {} min '{min_text}' exceeds max '{max_text}' in {}",
+            el.name,
+            bad.join(", ")
+        ),
+        None,
+    );
+    None
+}
+
+fn non_negative_std_dev(ctx: &mut Ctx, el: &Element, std_dev: [f64; 3]) -> Option<()> {
+    if std_dev.iter().all(|&s| s >= 0.0) {
+        return Some(());
+    }
+    let at = el
+        .attributes
+        .get("std_dev")
+        .map_or(el.location, |a| a.location);
+    ctx.error(
+        at,
+        format!("gaussian {} 'std_dev' must not be negative", el.name),
+        None,
+    );
+    None
+}
+
+/// How messages name an entity, e.g. `<e-puck> 'ep0'`.
+pub(super) fn describe(entity: &Entity) -> String {
+    format!("<{}> '{}'", entity.tag(), entity.id())
+}

@@ -1,0 +1,284 @@
+//! The message contract between the world and the robot agents.
+//!
+//! Both types are fixed-size `#[repr(C)]` plain data so that they travel through iceoryx2 shared memory without
+//! serialisation. The world writes one [`SensorFrame`] per robot per tick and reads one [`ActuatorCommand`] per robot
+//! per tick. A controller sees nothing of the world except what is in the frame (ARGoS' control-interface wall):
+//! if a callback needs something new, it is added here, not passed through a side channel.
+//!
+//! Capacities are compile-time constants because shared-memory layouts must be identical in every process; they
+//! are sized for the e-puck model and the thesis' tasks. Any change to a layout must bump [`MESSAGE_VERSION`],
+//! which is part of every service name, so processes built from different versions never connect.
+//!
+//! Across hosts the same types travel bincode-encoded (`Encode`/`Decode`, field by field, little-endian), never
+//! as raw memory, so hosts of different architectures interoperate (see `remote::codec`).
+
+use bincode::{Decode, Encode};
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
+pub const MESSAGE_VERSION: u32 = 1;
+
+/// Number of e-puck proximity sensors (also the light sensors: they share the IR ring).
+pub const PROXIMITY_SENSORS: usize = 8;
+/// Number of e-puck light sensors.
+pub const LIGHT_SENSORS: usize = 8;
+/// Number of e-puck ground sensors (left, centre, right).
+pub const GROUND_SENSORS: usize = 3;
+/// Most LED blobs the omnidirectional camera reports per tick; further blobs (farthest first) are dropped.
+pub const MAX_CAMERA_BLOBS: usize = 16;
+/// Most range-and-bearing messages a robot receives per tick; further messages (farthest first) are dropped.
+pub const MAX_RAB_MESSAGES: usize = 16;
+/// Largest range-and-bearing payload, in bytes (the IRIDIA e-puck's maximum).
+pub const RAB_PAYLOAD_BYTES: usize = 4;
+/// Number of pheromone channels in the world's field (e.g. trail and home).
+pub const PHEROMONE_CHANNELS: usize = 2;
+/// Most supervisors one robot may run.
+pub const MAX_SUPERVISORS: usize = 16;
+/// Most self-loop timer stamps a command can carry (docs/ptsct.md section 3).
+pub const MAX_FIRED_STAMPS: usize = 32;
+/// Most events one robot can fire in one tick (uncontrollable ones plus at most one controllable).
+pub const MAX_EVENTS_PER_TICK: usize = 16;
+
+/// An RGB colour, as LEDs show it and cameras see it. All zero means off.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct Rgb {
+    /// Red, 0-255.
+    pub r: u8,
+    /// Green, 0-255.
+    pub g: u8,
+    /// Blue, 0-255.
+    pub b: u8,
+}
+
+impl Rgb {
+    /// LEDs off.
+    pub const OFF: Rgb = Rgb { r: 0, g: 0, b: 0 };
+
+    /// Whether the LED is lit.
+    pub fn is_on(self) -> bool {
+        self != Self::OFF
+    }
+}
+
+/// One LED blob seen by the omnidirectional camera.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct CameraBlob {
+    /// Colour of the LED.
+    pub color: Rgb,
+    /// Bearing in radians in the robot frame, in [-pi, pi], counter-clockwise from the heading.
+    pub bearing: f32,
+    /// Distance from the robot centre in cm (the IRIDIA convention).
+    pub distance_cm: f32,
+}
+
+/// One range-and-bearing message received this tick.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct RabMessage {
+    /// Index of the sending robot in the run.
+    pub sender: u32,
+    /// Payload; only the first `len` bytes are meaningful.
+    pub payload: [u8; RAB_PAYLOAD_BYTES],
+    /// Number of meaningful payload bytes.
+    pub len: u8,
+    /// Range in cm minus two body radii (the IRIDIA convention).
+    pub range_cm: f32,
+    /// Bearing in radians in the receiver's frame, in [-pi, pi].
+    pub bearing: f32,
+}
+
+/// Everything one robot senses in one tick. Written by the world, read by the robot's agent.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct SensorFrame {
+    /// Tick this frame belongs to (1 for the first tick).
+    pub tick: u64,
+    /// Index of the robot in the run (0..N).
+    pub robot: u32,
+    /// Non-zero while the robot is alive in the world.
+    pub alive: u8,
+    /// Non-zero while the robot carries an object with its virtual gripper.
+    pub gripper_holding: u8,
+    /// Proximity readings in [0, 1] (0 nothing, 1 touching), sensor i at the e-puck's physical angle.
+    pub proximity: [f32; PROXIMITY_SENSORS],
+    /// Light readings in [0, 1].
+    pub light: [f32; LIGHT_SENSORS],
+    /// Ground readings in [0, 1] (1 white, 0 black); index 0 is the left sensor.
+    pub ground: [f32; GROUND_SENSORS],
+    /// Number of valid entries in `camera`.
+    pub camera_len: u8,
+    /// LED blobs seen by the omnidirectional camera, nearest first.
+    pub camera: [CameraBlob; MAX_CAMERA_BLOBS],
+    /// Number of valid entries in `rab`.
+    pub rab_len: u8,
+    /// Range-and-bearing messages received, nearest first.
+    pub rab: [RabMessage; MAX_RAB_MESSAGES],
+    /// Pheromone concentration at the robot's position, per channel.
+    pub pheromone: [f32; PHEROMONE_CHANNELS],
+    /// Pheromone gradient (d/dx, d/dy) in the robot frame, per channel.
+    pub pheromone_gradient: [[f32; 2]; PHEROMONE_CHANNELS],
+    /// Position in metres in the arena frame (the `positioning` sensor; controllers may ignore it).
+    pub position: [f32; 2],
+    /// Heading in radians, counter-clockwise from +X (the `positioning` sensor).
+    pub heading: f32,
+}
+
+impl SensorFrame {
+    /// An empty frame for `robot`: nothing sensed, alive, all ground sensors on white floor.
+    pub fn empty(robot: u32) -> Self {
+        Self {
+            tick: 0,
+            robot,
+            alive: 1,
+            gripper_holding: 0,
+            proximity: [0.0; PROXIMITY_SENSORS],
+            light: [0.0; LIGHT_SENSORS],
+            ground: [1.0; GROUND_SENSORS],
+            camera_len: 0,
+            camera: [CameraBlob::default(); MAX_CAMERA_BLOBS],
+            rab_len: 0,
+            rab: [RabMessage::default(); MAX_RAB_MESSAGES],
+            pheromone: [0.0; PHEROMONE_CHANNELS],
+            pheromone_gradient: [[0.0; 2]; PHEROMONE_CHANNELS],
+            position: [0.0; 2],
+            heading: 0.0,
+        }
+    }
+
+    /// Fills `frames`, the frames of robots `first..`, for `tick` with `sense(tick, first, frames)`: each
+    /// starts as [`SensorFrame::empty`] with the tick, and its `tick` and `robot` are enforced afterwards, so
+    /// a sense function can neither misdate a frame nor move it to another robot.
+    pub fn sense_into(
+        tick: u64,
+        first: usize,
+        frames: &mut [SensorFrame],
+        sense: &mut impl FnMut(u64, usize, &mut [SensorFrame]),
+    ) {
+        for (robot, frame) in (first as u32..).zip(frames.iter_mut()) {
+            *frame = SensorFrame::empty(robot);
+            frame.tick = tick;
+        }
+        sense(tick, first, frames);
+        for (robot, frame) in (first as u32..).zip(frames.iter_mut()) {
+            frame.tick = tick;
+            frame.robot = robot;
+        }
+    }
+
+    /// The valid camera blobs.
+    pub fn camera_blobs(&self) -> &[CameraBlob] {
+        &self.camera[..usize::from(self.camera_len).min(MAX_CAMERA_BLOBS)]
+    }
+
+    /// The valid range-and-bearing messages.
+    pub fn rab_messages(&self) -> &[RabMessage] {
+        &self.rab[..usize::from(self.rab_len).min(MAX_RAB_MESSAGES)]
+    }
+}
+
+/// What the virtual gripper should do this tick.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub enum GripperAction {
+    /// Keep the current state.
+    #[default]
+    Hold = 0,
+    /// Pick up the nearest target within reach (edge-to-edge gap at most 7 mm).
+    Pick = 1,
+    /// Drop the carried target at the robot's position.
+    Drop = 2,
+}
+
+/// The tick at which a controllable self-loop last fired in its supervisor's current state (docs/ptsct.md section 3).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct FiredStamp {
+    /// Index of the supervisor in the robot's supervisor set.
+    pub supervisor: u8,
+    /// Global event id.
+    pub event: u8,
+    /// Tick of the last firing.
+    pub tick: u64,
+}
+
+/// The state of a robot's supervisors after a player step: enough to record and to resume them exactly.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct SupervisorSnapshot {
+    /// Number of supervisors in use.
+    pub count: u8,
+    /// Current state of each supervisor.
+    pub states: [u16; MAX_SUPERVISORS],
+    /// Tick at which each supervisor entered its current state.
+    pub entered: [u64; MAX_SUPERVISORS],
+    /// Number of valid entries in `fired`.
+    pub fired_len: u8,
+    /// Self-loop timer stamps of the current states.
+    pub fired: [FiredStamp; MAX_FIRED_STAMPS],
+}
+
+impl Default for SupervisorSnapshot {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            states: [0; MAX_SUPERVISORS],
+            entered: [0; MAX_SUPERVISORS],
+            fired_len: 0,
+            fired: [FiredStamp::default(); MAX_FIRED_STAMPS],
+        }
+    }
+}
+
+/// Everything one robot commands in one tick, plus what it did. Written by the agent, read by the world.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub struct ActuatorCommand {
+    /// Tick this command answers (equal to the frame's tick).
+    pub tick: u64,
+    /// Index of the robot in the run.
+    pub robot: u32,
+    /// Left and right wheel speeds in cm/s (the world clamps them to the robot's limit).
+    pub wheels: [f32; 2],
+    /// LED colour.
+    pub led: Rgb,
+    /// Number of range-and-bearing payload bytes to broadcast this tick (0 = send nothing).
+    pub rab_len: u8,
+    /// Range-and-bearing payload.
+    pub rab_payload: [u8; RAB_PAYLOAD_BYTES],
+    /// Gripper action.
+    pub gripper: GripperAction,
+    /// Amount of pheromone to deposit at the robot's position, per channel.
+    pub pheromone_deposit: [f32; PHEROMONE_CHANNELS],
+    /// Number of valid entries in `events`.
+    pub events_len: u8,
+    /// Global ids of the events fired this tick, in firing order (for `events.csv`).
+    pub events: [u8; MAX_EVENTS_PER_TICK],
+    /// Supervisor states and timers after this tick's step.
+    pub supervisors: SupervisorSnapshot,
+}
+
+impl ActuatorCommand {
+    /// The command of a robot that does nothing: wheels stopped, LEDs off.
+    pub fn idle(robot: u32, tick: u64) -> Self {
+        Self {
+            tick,
+            robot,
+            wheels: [0.0; 2],
+            led: Rgb::OFF,
+            rab_len: 0,
+            rab_payload: [0; RAB_PAYLOAD_BYTES],
+            gripper: GripperAction::Hold,
+            pheromone_deposit: [0.0; PHEROMONE_CHANNELS],
+            events_len: 0,
+            events: [0; MAX_EVENTS_PER_TICK],
+            supervisors: SupervisorSnapshot::default(),
+        }
+    }
+
+    /// The events fired this tick.
+    pub fn fired_events(&self) -> &[u8] {
+        &self.events[..usize::from(self.events_len).min(MAX_EVENTS_PER_TICK)]
+    }
+}

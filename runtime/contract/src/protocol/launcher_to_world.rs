@@ -1,0 +1,179 @@
+//! From the launcher to the world process: its command line ([`WorldArgs`], parsed by the world with the same type)
+//! and the lines the launcher writes on its standard input ([`WorldCommand`]).
+//!
+//! Those lines: `dead 3` (the OS reported robot 3's agent gone), `rejoin 3 58` (robot 3's replacement takes part from tick
+//! 58: the world holds that tick until it has joined) and `applied 50` (every fault due at tick 50 is done: the
+//! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`) and
+//! `respawn 3` (robot 3's restart policy replaces its agent: the world takes it back once the replacement is
+//! there; for a robot on a host the world has the host start it, resuming from the world's record). Plain text,
+//! so a person can drive a world by hand.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::launcher_to_agent::RunArgs;
+
+/// Flags of the world process (`swarm-world`).
+#[derive(Debug, Clone, PartialEq, Args)]
+pub struct WorldArgs {
+    /// The run's shared memory.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// The experiment configuration.
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Run seed (already resolved: never 0-from-the-clock here).
+    #[arg(long)]
+    pub seed: u64,
+    /// Ticks to run; 0 runs until the loop functions finish the experiment or the launcher stops it.
+    #[arg(long, default_value_t = 0)]
+    pub ticks: u64,
+    /// Number of robots, overriding the configuration's e-puck `<distribute>` quantity.
+    #[arg(long)]
+    pub robots: Option<u32>,
+    /// Run directory the world writes its records into.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Milliseconds a tick waits for missing commands before it goes on without them.
+    #[arg(long = "tick-deadline-ms")]
+    pub tick_deadline_ms: Option<u64>,
+    /// Milliseconds the world waits for every agent to join before the first tick.
+    #[arg(long = "join-timeout-ms", default_value_t = 120_000)]
+    pub join_timeout_ms: u64,
+    /// Pace the ticks at the configuration's ticks_per_second instead of running as fast as possible.
+    #[arg(long = "real-time")]
+    pub real_time: bool,
+    /// Faults given on the command line (`swarm run --fault`), added to the configuration's `<faults>`.
+    #[arg(long = "fault")]
+    pub faults: Vec<String>,
+}
+
+impl WorldArgs {
+    /// The flags as a command line.
+    pub fn to_args(&self) -> Vec<String> {
+        let mut args = self.run.to_args();
+        args.extend([
+            "--config".into(),
+            self.config.display().to_string(),
+            "--seed".into(),
+            self.seed.to_string(),
+            "--ticks".into(),
+            self.ticks.to_string(),
+            "--out".into(),
+            self.out.display().to_string(),
+            "--join-timeout-ms".into(),
+            self.join_timeout_ms.to_string(),
+        ]);
+        if let Some(robots) = self.robots {
+            args.extend(["--robots".into(), robots.to_string()]);
+        }
+        if let Some(ms) = self.tick_deadline_ms {
+            args.extend(["--tick-deadline-ms".into(), ms.to_string()]);
+        }
+        if self.real_time {
+            args.push("--real-time".into());
+        }
+        for fault in &self.faults {
+            args.extend(["--fault".into(), fault.clone()]);
+        }
+        args
+    }
+}
+
+/// One line from the launcher to the world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WorldCommand {
+    /// Robot's agent is gone (death notice).
+    Dead(u32),
+    /// Robot's replacement agent takes part from this tick on.
+    Rejoin {
+        /// The robot.
+        robot: u32,
+        /// The tick.
+        tick: u64,
+    },
+    /// The faults due at this tick are applied.
+    Applied(u64),
+    /// Host with this index in the placement is to die.
+    KillHost(u32),
+    /// Robot gets a replacement agent.
+    Respawn(u32),
+}
+
+impl fmt::Display for WorldCommand {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            WorldCommand::Dead(robot) => write!(f, "dead {robot}"),
+            WorldCommand::Rejoin { robot, tick } => write!(f, "rejoin {robot} {tick}"),
+            WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
+            WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
+            WorldCommand::Respawn(robot) => write!(f, "respawn {robot}"),
+        }
+    }
+}
+
+impl WorldCommand {
+    /// Parses one line; `None` for anything else.
+    pub fn parse(line: &str) -> Option<WorldCommand> {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["dead", robot] => Some(WorldCommand::Dead(robot.parse().ok()?)),
+            ["rejoin", robot, tick] => Some(WorldCommand::Rejoin {
+                robot: robot.parse().ok()?,
+                tick: tick.parse().ok()?,
+            }),
+            ["applied", tick] => Some(WorldCommand::Applied(tick.parse().ok()?)),
+            ["kill-host", host] => Some(WorldCommand::KillHost(host.parse().ok()?)),
+            ["respawn", robot] => Some(WorldCommand::Respawn(robot.parse().ok()?)),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::*;
+    use crate::protocol::launcher_to_agent::tests::run;
+
+    #[derive(Parser)]
+    struct World {
+        #[command(flatten)]
+        args: WorldArgs,
+    }
+
+    #[test]
+    fn world_command_line_parses_back_to_the_same_flags() {
+        let args = WorldArgs {
+            run: run(),
+            config: PathBuf::from("configs/x.argos"),
+            seed: 124,
+            ticks: 600,
+            robots: Some(40),
+            out: PathBuf::from("runs/x"),
+            tick_deadline_ms: Some(250),
+            join_timeout_ms: 5_000,
+            real_time: true,
+            faults: vec!["kill robots=3 tick=50".into()],
+        };
+        let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
+        assert_eq!(World::parse_from(line).args, args);
+    }
+
+    #[test]
+    fn every_command_parses_back_from_its_line() {
+        for command in [
+            WorldCommand::Dead(3),
+            WorldCommand::Rejoin { robot: 3, tick: 58 },
+            WorldCommand::Applied(50),
+            WorldCommand::KillHost(1),
+            WorldCommand::Respawn(4),
+        ] {
+            assert_eq!(WorldCommand::parse(&command.to_string()), Some(command));
+        }
+        assert_eq!(WorldCommand::parse("dead three"), None);
+    }
+}

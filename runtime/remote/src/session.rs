@@ -1,0 +1,186 @@
+//! Opening the zenoh sessions of a multi-host run: the world listens, each host daemon connects to it.
+//!
+//! Multicast scouting is off and every endpoint is explicit, so nothing is discovered by accident (hosts are
+//! clients, so the world's peer gossip never reaches them). The world runs in
+//! peer mode and listens (loopback by default); hosts run in client mode and connect to one of its endpoints,
+//! retrying every second while it is unreachable (so a host whose network came back rejoins by itself). The link
+//! lease decides how fast a frozen or cut-off host is noticed (default 1 s; a killed one is noticed in
+//! milliseconds, when its TCP connection closes). User/password authentication and TLS certificates are set
+//! here; a zenoh configuration file can supply anything else.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use swarm_contract::config::hosts::TlsFiles;
+use zenoh::{Config, Session, Wait};
+
+use super::RemoteError;
+
+/// Default link lease: a frozen or cut-off host is noticed after about this long.
+pub const DEFAULT_LEASE: Duration = Duration::from_secs(1);
+/// Default endpoint the world listens on (loopback only).
+pub const DEFAULT_LISTEN: &str = "tcp/127.0.0.1:7447";
+
+/// What every zenoh session of a multi-host run is configured with.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ZenohOptions {
+    /// A zenoh configuration file (JSON5) to start from; our settings are applied on top.
+    pub config_file: Option<PathBuf>,
+    /// Link lease: how long a silent peer stays alive.
+    pub lease: Duration,
+    /// User name for zenoh's user/password authentication (with `password`).
+    pub user: Option<String>,
+    /// Password for zenoh's user/password authentication.
+    pub password: Option<String>,
+    /// File of `user:password` lines the listening side accepts (zenoh's `dictionary_file`).
+    pub credentials_file: Option<PathBuf>,
+    /// Certificates for `tls/...` endpoints.
+    pub tls: TlsFiles,
+}
+
+impl Default for ZenohOptions {
+    fn default() -> Self {
+        ZenohOptions {
+            config_file: None,
+            lease: DEFAULT_LEASE,
+            user: None,
+            password: None,
+            credentials_file: None,
+            tls: TlsFiles::default(),
+        }
+    }
+}
+
+/// Wraps a zenoh error with what was being done.
+pub(super) fn zenoh_error(action: impl Into<String>) -> impl FnOnce(zenoh::Error) -> RemoteError {
+    let action = action.into();
+    move |e| RemoteError::Zenoh {
+        action,
+        detail: e.to_string(),
+    }
+}
+
+/// A JSON string literal.
+fn json(s: &str) -> String {
+    serde_json::Value::String(s.to_owned()).to_string()
+}
+
+/// A path as a JSON string literal.
+fn json_path(path: &std::path::Path) -> String {
+    json(&path.display().to_string())
+}
+
+/// Sets one key of a zenoh configuration, saying which on failure.
+fn set(config: &mut Config, key: &str, value: &str) -> Result<(), RemoteError> {
+    config
+        .insert_json5(key, value)
+        .map_err(zenoh_error(format!("setting zenoh's {key} to {value}")))
+}
+
+/// Which end of a link the TLS files are for.
+#[derive(Clone, Copy)]
+enum TlsSide {
+    Listen,
+    Connect,
+}
+
+const TLS: &str = "transport/link/tls";
+
+impl ZenohOptions {
+    /// The zenoh configuration for `mode` with our common settings.
+    fn config(&self, mode: &str, side: TlsSide) -> Result<Config, RemoteError> {
+        let mut config = match &self.config_file {
+            Some(path) => Config::from_file(path).map_err(zenoh_error(format!(
+                "reading the zenoh configuration {}",
+                path.display()
+            )))?,
+            None => Config::default(),
+        };
+        let lease_ms = self.lease.as_millis().max(1);
+        set(&mut config, "mode", &json(mode))?;
+        set(&mut config, "scouting/multicast/enabled", "false")?;
+        set(
+            &mut config,
+            "transport/link/tx/lease",
+            &lease_ms.to_string(),
+        )?;
+        set(
+            &mut config,
+            "connect/retry",
+            r#"{"period_init_ms": 250, "period_max_ms": 1000, "period_increase_factor": 2}"#,
+        )?;
+        if let Some(user) = &self.user {
+            set(&mut config, "transport/auth/usrpwd/user", &json(user))?;
+        }
+        if let Some(password) = &self.password {
+            // Not through `set`: its error would quote the password.
+            config
+                .insert_json5("transport/auth/usrpwd/password", &json(password))
+                .map_err(zenoh_error("setting zenoh's password"))?;
+        }
+        if let Some(file) = &self.credentials_file {
+            set(
+                &mut config,
+                "transport/auth/usrpwd/dictionary_file",
+                &json_path(file),
+            )?;
+        }
+        self.set_tls(&mut config, side)?;
+        Ok(config)
+    }
+
+    /// The TLS files as zenoh's `transport/link/tls` settings for one end of the link.
+    fn set_tls(&self, config: &mut Config, side: TlsSide) -> Result<(), RemoteError> {
+        let tls = &self.tls;
+        let (certificate, private_key) = match side {
+            TlsSide::Listen => ("listen_certificate", "listen_private_key"),
+            TlsSide::Connect => ("connect_certificate", "connect_private_key"),
+        };
+        // zenoh asks for (listening) or presents (connecting) a client certificate only with `enable_mtls`.
+        let mutual = match side {
+            TlsSide::Listen => tls.root_ca.is_some(),
+            TlsSide::Connect => tls.certificate.is_some(),
+        };
+        if mutual {
+            set(config, &format!("{TLS}/enable_mtls"), "true")?;
+        }
+        if let Some(path) = &tls.root_ca {
+            set(
+                config,
+                &format!("{TLS}/root_ca_certificate"),
+                &json_path(path),
+            )?;
+        }
+        if let Some(path) = &tls.certificate {
+            set(config, &format!("{TLS}/{certificate}"), &json_path(path))?;
+        }
+        if let Some(path) = &tls.private_key {
+            set(config, &format!("{TLS}/{private_key}"), &json_path(path))?;
+        }
+        Ok(())
+    }
+
+    /// The world's session: peer mode, listening on `listen` (e.g. `tcp/127.0.0.1:7447`).
+    pub fn open_world(&self, listen: &[String]) -> Result<Session, RemoteError> {
+        let mut config = self.config("peer", TlsSide::Listen)?;
+        let endpoints = serde_json::to_string(listen).unwrap_or_else(|_| "[]".into());
+        set(&mut config, "listen/endpoints", &endpoints)?;
+        set(&mut config, "connect/endpoints", "[]")?;
+        zenoh::open(config).wait().map_err(zenoh_error(format!(
+            "opening the world's session on {endpoints}"
+        )))
+    }
+
+    /// A host's session: client mode, connected to `endpoint` (retried until it answers).
+    pub fn open_host(&self, endpoint: &str) -> Result<Session, RemoteError> {
+        let mut config = self.config("client", TlsSide::Connect)?;
+        let endpoints = serde_json::to_string(&[endpoint]).unwrap_or_else(|_| "[]".into());
+        set(&mut config, "connect/endpoints", &endpoints)?;
+        set(&mut config, "listen/endpoints", "[]")?;
+        set(&mut config, "connect/timeout_ms", "-1")?;
+        set(&mut config, "connect/exit_on_failure", "false")?;
+        zenoh::open(config)
+            .wait()
+            .map_err(zenoh_error(format!("connecting to {endpoint}")))
+    }
+}

@@ -1,0 +1,230 @@
+//! `swarm-world`: the world process of a run.
+//!
+//! Builds the arena from the experiment, creates the run's shared-memory services for N robots, says `ready`,
+//! waits for the agents, then runs the lockstep: sense every robot into the shared frames, wake the agents, wait
+//! for their commands (a dead or late robot never blocks: it holds still), act, step physics and media, record.
+//! Progress goes to standard output as [`WorldReport`] lines for the launcher; the launcher's lines on standard
+//! input (death notices, restarts, applied faults) and the fault schedule are handled in [`faults`], the same
+//! way whether the robots run here or on hosts.
+//! SIGINT/SIGTERM end the run after the current tick with every record flushed. Normally started by `swarm run`;
+//! the flags are documented by `swarm-world --help`. With hosts (`--hosts` or `<hosts>`), the robots run on
+//! `swarm host` daemons reached over zenoh instead ([`remote`]).
+
+mod faults;
+mod pacing;
+mod remote;
+mod ticking_cpu;
+
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Parser;
+use swarm_contract::config::Experiment;
+use swarm_contract::config::faults::FaultSchedule;
+use swarm_contract::messages::ActuatorCommand;
+use swarm_contract::protocol::launcher_to_world::WorldArgs;
+use swarm_contract::protocol::world_to_launcher::WorldReport;
+use swarm_contract::transport::{LinkConfig, RunSpec, WorldLink, priority};
+use swarm_remote::plan::{HostsArgs, HostsPlan};
+use swarm_world::World;
+use swarm_world::recorder::Recorder;
+
+use faults::FaultDriver;
+use pacing::Pacer;
+use remote::Link;
+use ticking_cpu::TickingCpu;
+
+/// Minimum interval between two progress reports to the launcher.
+const REPORT_INTERVAL: Duration = Duration::from_millis(50);
+
+/// The world process of a swarm run.
+#[derive(Debug, Parser)]
+#[command(name = "swarm-world", version, about)]
+struct Cli {
+    #[command(flatten)]
+    args: WorldArgs,
+    #[command(flatten)]
+    hosts: HostsArgs,
+}
+
+fn main() -> ExitCode {
+    swarm_contract::logging::init("info");
+    let cli = Cli::parse();
+    match run(&cli.args, &cli.hosts) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("swarm-world: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Prints one report line for the launcher.
+fn report(line: WorldReport) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{line}");
+    let _ = out.flush();
+}
+
+fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+        .context("installing the stop handler")?;
+
+    let (experiment, _warnings) = Experiment::load(&args.config)?;
+    let experiment = match args.robots {
+        Some(n) => experiment.with_robot_count(n)?,
+        None => experiment,
+    };
+    let mut world = World::new(&experiment, args.seed)?;
+    let robots = world.robot_count();
+    let controller_ids: Vec<&str> = experiment
+        .controllers
+        .iter()
+        .map(|c| c.id.as_str())
+        .collect();
+    let schedule = FaultSchedule::load(&args.config, &args.faults, robots as u32, &controller_ids)?;
+    world.set_dead_bodies(schedule.dead_bodies);
+    let roster: Vec<(String, String)> = experiment
+        .arena
+        .robots()
+        .into_iter()
+        .map(|r| (r.id, r.epuck.controller.clone()))
+        .collect();
+
+    let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;
+    let mut link_config = LinkConfig::new(robots as u32);
+    if let Some(ms) = args.tick_deadline_ms {
+        link_config.tick_deadline = Duration::from_millis(ms);
+    }
+    link_config.pin_chains = experiment.framework.pin_agents;
+    link_config.realtime = priority::tick_at_realtime(experiment.framework.realtime_priority);
+    let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
+        None => {
+            let link = WorldLink::create(&run, link_config)?;
+            let launcher = faults::follow_launcher(Some(link.death_notices()));
+            (Link::Local(link), launcher)
+        }
+        Some(plan) => {
+            let controllers = roster.iter().map(|(_, c)| c.clone()).collect();
+            let link = Link::remote(
+                plan,
+                args,
+                controllers,
+                link_config.tick_deadline,
+                link_config.pin_chains,
+                experiment.framework.realtime_priority,
+            )?;
+            (link, faults::follow_launcher(None))
+        }
+    };
+    let mut faults = FaultDriver::new(
+        &link,
+        &schedule,
+        experiment.framework.ticks_per_second,
+        args.seed,
+        launcher,
+        args.out.clone(),
+        Duration::from_millis(args.join_timeout_ms),
+    )?;
+    let mut recorder = Recorder::create(&args.out, &world, &[0])?;
+    recorder.record(&world)?;
+    report(WorldReport::Ready {
+        robots: robots as u32,
+    });
+
+    let mut commands: Vec<ActuatorCommand> = (0..robots)
+        .map(|i| ActuatorCommand::idle(i as u32, 0))
+        .collect();
+    faults.wait_for_agents(&mut link, &mut world, &mut recorder, &commands)?;
+    let cpu = TickingCpu::start(&link);
+    let started = Instant::now();
+    let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
+    let mut has_command = vec![false; robots];
+    let mut robot_steps: u64 = 0;
+    // Commands that missed their tick's deadline: a run with none is a pure function of (config, seed, faults).
+    let mut commands_missing: u64 = 0;
+    let mut last_report = Instant::now();
+    let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
+    while !stop.load(Ordering::Relaxed)
+        && !world.is_finished()
+        && (args.ticks == 0 || link.tick() < args.ticks)
+    {
+        faults.before_tick(
+            link.tick() + 1,
+            &mut link,
+            &mut world,
+            &mut recorder,
+            &commands,
+        )?;
+        let tick_started = Instant::now();
+        let outcome = link.tick_with(|_, first, frames| world.sense_robots(first, frames))?;
+        for robot in 0..robots {
+            match link
+                .command(robot as u32)
+                .filter(|_| faults.is_alive(robot))
+            {
+                Some(command) => {
+                    commands[robot] = *command;
+                    has_command[robot] = true;
+                    recorder.record_command(robot, command);
+                }
+                None => has_command[robot] = false,
+            }
+        }
+        world.act_and_step(&commands, &has_command);
+        recorder.record(&world)?;
+        tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
+        robot_steps += u64::from(outcome.answered);
+        commands_missing += u64::from(outcome.missing);
+        if outcome.tick == 1 || last_report.elapsed() >= REPORT_INTERVAL {
+            last_report = Instant::now();
+            report(WorldReport::Tick {
+                tick: outcome.tick,
+                answered: outcome.answered,
+                missing: outcome.missing,
+                dead: outcome.dead,
+            });
+        }
+        pacer.end_of_tick(outcome.tick);
+    }
+    let ticking = started.elapsed().as_secs_f64();
+    let cpu = cpu.map(|cpu| cpu.summary(&link, robot_steps));
+    let ticks = link.tick();
+    let mut extra = serde_json::json!({
+        "robot_steps": robot_steps,
+        "commands_missing": commands_missing,
+        "ticking_seconds": ticking,
+        "robot_steps_per_second": if ticking > 0.0 { robot_steps as f64 / ticking } else { 0.0 },
+        "tick_micros_p50": percentile(&mut tick_micros, 0.50),
+        "tick_micros_p99": percentile(&mut tick_micros, 0.99),
+        "real_time": pacer.summary(ticks),
+    });
+    if let Some(object) = extra.as_object_mut() {
+        object.insert("alive_final".into(), faults.alive_count().into());
+        if let Some(hosts) = link.summary() {
+            object.insert("hosts".into(), hosts);
+        }
+        if let Some(serde_json::Value::Object(cpu)) = cpu {
+            object.extend(cpu);
+        }
+    }
+    recorder.finish(&world, extra)?;
+    report(WorldReport::Finished { ticks });
+    Ok(())
+}
+
+/// The `q` quantile of the tick times in microseconds (0 when there were no ticks).
+fn percentile(samples: &mut [u32], q: f64) -> u32 {
+    if samples.is_empty() {
+        return 0;
+    }
+    samples.sort_unstable();
+    let rank = ((samples.len() - 1) as f64 * q).round() as usize;
+    samples[rank.min(samples.len() - 1)]
+}

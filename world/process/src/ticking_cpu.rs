@@ -1,0 +1,56 @@
+//! CPU time of the ticking phase, from the scheduler's own accounts (`swarm_contract::cpu`): the agents'
+//! per robot-step and the world process's (every thread) per tick. Throughput on a shared machine swings with
+//! the neighbours; the CPU an agent needs per step moves far less, so these two figures say where a tick's time
+//! goes and rank changes that throughput alone cannot.
+//!
+//! Only local runs have them (the agents of hosts are other machines' processes), and the agents' figure only
+//! when the agents that ended the run are the ones that started it: a replaced agent takes its CPU time with it.
+
+use swarm_contract::cpu::CpuMark;
+
+use crate::remote::Link;
+
+/// The marks taken at the first tick.
+pub struct TickingCpu {
+    agents: Vec<u32>,
+    agents_mark: CpuMark,
+    world_mark: CpuMark,
+    first_tick: u64,
+}
+
+impl TickingCpu {
+    /// Marks the CPU used so far by the agents of a local link and by this process; `None` on hosts.
+    pub fn start(link: &Link) -> Option<TickingCpu> {
+        let Link::Local(local) = link else {
+            return None;
+        };
+        let agents = local.agent_pids();
+        Some(TickingCpu {
+            agents_mark: CpuMark::take_of(agents.iter().copied()),
+            world_mark: CpuMark::take_of([std::process::id()]),
+            agents,
+            first_tick: link.tick(),
+        })
+    }
+
+    /// The figures for summary.json after `robot_steps` answered steps: `cpu_world_us_per_tick` and, when no
+    /// agent was replaced, `cpu_agents_us_per_robot_step`.
+    pub fn summary(&self, link: &Link, robot_steps: u64) -> serde_json::Value {
+        let ticks = link.tick().saturating_sub(self.first_tick) as f64;
+        let world = self.world_mark.per_step_of([std::process::id()], ticks);
+        let same_agents = match link {
+            Link::Local(local) => local.agent_pids() == self.agents,
+            Link::Remote(_) => false,
+        };
+        let agents = same_agents.then(|| {
+            self.agents_mark
+                .per_step_of(self.agents.iter().copied(), robot_steps as f64)
+                .as_secs_f64()
+                * 1e6
+        });
+        serde_json::json!({
+            "cpu_world_us_per_tick": world.as_secs_f64() * 1e6,
+            "cpu_agents_us_per_robot_step": agents,
+        })
+    }
+}
