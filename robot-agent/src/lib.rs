@@ -5,6 +5,8 @@
 //! It sees only `swarm_contract`: the sensor frame, the actuator command, the player and the transport. It never
 //! depends on the world.
 
+#![warn(missing_docs)]
+
 pub mod binding;
 pub mod control;
 pub mod controller;

@@ -7,6 +7,8 @@
 //!
 //! This crate depends on nothing else of the workspace.
 
+#![warn(missing_docs)]
+
 pub mod architecture;
 pub mod automaton;
 pub mod build;

@@ -5,6 +5,8 @@
 //! (`sw<pid in hex>-...`): every shared-memory file is `/dev/shm/iox2_<run>_*` and every child's command line
 //! carries `--run <run>`.
 
+#![warn(missing_docs)]
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
