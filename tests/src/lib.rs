@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
+use swarm_contract::process::binaries::without_cargo_package_env;
 use swarm_contract::transport::RUN_ROOTS_DIR;
 
 /// The folder holding `swarm`, `swarm-world` and `robot-agent`, brought up to date once per test binary with the
@@ -22,14 +23,9 @@ pub fn bin_dir() -> &'static Path {
     DIR.get_or_init(|| {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let mut command = Command::new(cargo);
-        // Cargo gives a test process the variables of the package under test (CARGO_MANIFEST_DIR, CARGO_PKG_NAME,
-        // ...). Build scripts that watch them (ring's does) would see them changed and rebuild the TLS stack and
-        // everything above it, so the inner cargo gets the environment the outer one was started with.
-        for (name, _) in std::env::vars_os() {
-            if name.to_str().is_some_and(set_by_cargo_for_tests) {
-                command.env_remove(name);
-            }
-        }
+        // Cargo gives a test process the variables of the package under test; the inner cargo gets the
+        // environment the outer one was started with, or it would rebuild the TLS stack.
+        without_cargo_package_env(&mut command);
         let status = command
             .args(["test", "--quiet", "--workspace", "--no-run"])
             .current_dir(workspace_root())
@@ -43,22 +39,6 @@ pub fn bin_dir() -> &'static Path {
             .expect("test binaries live in target/<profile>/deps")
             .to_path_buf()
     })
-}
-
-/// Whether cargo sets the environment variable `name` for the test binaries it runs (and for build scripts).
-fn set_by_cargo_for_tests(name: &str) -> bool {
-    const EXACT: [&str; 9] = [
-        "CARGO_MANIFEST_DIR",
-        "CARGO_MANIFEST_PATH",
-        "CARGO_MANIFEST_LINKS",
-        "CARGO_CRATE_NAME",
-        "CARGO_BIN_NAME",
-        "CARGO_PRIMARY_PACKAGE",
-        "CARGO_TARGET_TMPDIR",
-        "CARGO_RUSTC_CURRENT_DIR",
-        "OUT_DIR",
-    ];
-    EXACT.contains(&name) || name.starts_with("CARGO_PKG_") || name.starts_with("CARGO_BIN_EXE_")
 }
 
 /// The workspace root (the parent of this crate).

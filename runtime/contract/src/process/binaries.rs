@@ -99,6 +99,35 @@ fn find(dir: &Path, program: &'static str) -> Result<PathBuf, BinariesError> {
     }
 }
 
+/// Removes from `command` the environment variables cargo sets for the program it runs (`cargo run`, `cargo
+/// test`): the package under test's name, version, manifest and the like. Build scripts that watch them (ring's
+/// does) would see them changed and rebuild the TLS stack and everything above it, so a cargo started from a
+/// program cargo ran gets the environment the outer cargo was started with.
+pub fn without_cargo_package_env(command: &mut Command) -> &mut Command {
+    for (name, _) in std::env::vars_os() {
+        if name.to_str().is_some_and(set_by_cargo_for_programs) {
+            command.env_remove(name);
+        }
+    }
+    command
+}
+
+/// Whether cargo sets the environment variable `name` for the programs it runs (and for build scripts).
+fn set_by_cargo_for_programs(name: &str) -> bool {
+    const EXACT: [&str; 9] = [
+        "CARGO_MANIFEST_DIR",
+        "CARGO_MANIFEST_PATH",
+        "CARGO_MANIFEST_LINKS",
+        "CARGO_CRATE_NAME",
+        "CARGO_BIN_NAME",
+        "CARGO_PRIMARY_PACKAGE",
+        "CARGO_TARGET_TMPDIR",
+        "CARGO_RUSTC_CURRENT_DIR",
+        "OUT_DIR",
+    ];
+    EXACT.contains(&name) || name.starts_with("CARGO_PKG_") || name.starts_with("CARGO_BIN_EXE_")
+}
+
 /// Builds the sibling packages with the profile of the target folder `dir` (`.../target/<profile>`).
 fn build_with_cargo(cargo: &str, dir: &Path) -> Result<(), BinariesError> {
     let Some(profile) = dir.file_name().and_then(|p| p.to_str()) else {
@@ -112,6 +141,7 @@ fn build_with_cargo(cargo: &str, dir: &Path) -> Result<(), BinariesError> {
         return Ok(());
     }
     let mut command = Command::new(cargo);
+    without_cargo_package_env(&mut command);
     // The whole workspace's programs: `cargo run --bin swarm` in the workspace resolves features over every
     // member too, so this build finds every dependency fresh and compiles only the missing programs, with
     // cargo's own progress on the terminal.
