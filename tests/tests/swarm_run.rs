@@ -40,10 +40,19 @@ fn run_ok(config: &str, out: &Path, extra: &[&str]) -> SwarmOutcome {
 #[test]
 fn forty_robot_run_completes_with_one_process_per_robot() {
     let out = temp_dir();
-    let outcome = run_ok(OBSTACLE_AVOIDANCE, out.path(), &["--ticks", "40"]);
+    let outcome = run_ok(
+        OBSTACLE_AVOIDANCE,
+        out.path(),
+        &["--ticks", "40", "--limit", "fault_apply_timeout_ms=12345"],
+    );
     let summary = summary(out.path());
     assert_eq!(summary["robots"], 40);
     assert_eq!(summary["ticks"], 40);
+    assert_eq!(
+        summary["limits"]["fault_apply_timeout_ms"], 12345,
+        "the run records the limits it used, with the command line's"
+    );
+    assert_eq!(summary["limits"]["tick_deadline_ms"], 500);
     let agents: Vec<u64> = summary["processes"]["agents"]
         .as_array()
         .expect("agent pids are listed")

@@ -10,6 +10,7 @@
 //! - the local lockstep [`transport`] over iceoryx2 shared memory;
 //! - the protocol between the processes of a run ([`protocol`], one file per direction), the programs and child
 //!   processes of a run ([`process`]) and the files of a run directory ([`run_dir`]);
+//! - every timeout and size limit of a run, with its default ([`limits`]);
 //! - small shared services: [`logging`], scheduler CPU accounts ([`cpu`]) and an allocation counter for tests
 //!   ([`alloc_count`]).
 //!
@@ -21,6 +22,7 @@ pub mod alloc_count;
 pub mod config;
 pub mod cpu;
 pub mod fault_plan;
+pub mod limits;
 pub mod logging;
 pub mod messages;
 pub mod player;

@@ -1048,3 +1048,38 @@ fn bad_fixture_file_reports_its_path_line_and_column() {
         )
     );
 }
+
+#[test]
+fn a_limit_in_system_must_be_a_whole_number_above_zero() {
+    let text = config(&[(
+        r#"<system threads="0"/>"#,
+        r#"<system threads="0" tick_deadline_ms="0"/>"#,
+    )]);
+    assert_error(
+        &text,
+        r#"tick_deadline_ms="0""#,
+        "in <system>: limit tick_deadline_ms=0: the value must be a whole number above 0",
+    );
+}
+
+#[test]
+fn limits_in_system_override_the_defaults_and_a_misspelt_one_is_named() {
+    let text = config(&[(
+        r#"<system threads="0"/>"#,
+        r#"<system threads="0" join_timeout_ms="4000" tick_deadline="300"/>"#,
+    )]);
+    let (experiment, warnings) = Experiment::parse(PATH, &text).expect("valid");
+    let limits = experiment.framework.limits;
+    assert_eq!(limits.join_timeout_ms, 4000);
+    assert_eq!(
+        limits.tick_deadline_ms, 500,
+        "the misspelt attribute sets nothing"
+    );
+    let warnings: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert!(
+        warnings.iter().any(
+            |w| w.contains("'tick_deadline'") && w.contains("did you mean 'tick_deadline_ms'?")
+        ),
+        "{warnings:?}"
+    );
+}

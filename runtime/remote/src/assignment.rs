@@ -34,6 +34,8 @@ pub struct Assignment {
     pub tick_deadline_ms: u64,
     /// How long the host may take to start its agents (milliseconds).
     pub join_timeout_ms: u64,
+    /// How long the host's agents get to exit by themselves when the share ends (milliseconds).
+    pub agent_exit_grace_ms: u64,
     /// Whether the host's agents pin themselves to CPUs by chain (`<system pin_threads_to_cores>`).
     pub pin_agents: bool,
     /// Whether the host's ticking thread and agents run at real-time priority if the host allows it

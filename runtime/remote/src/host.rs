@@ -743,7 +743,10 @@ impl Drop for Share {
     fn drop(&mut self) {
         // Ending the local run tells the agents to exit; stragglers are killed after a grace period.
         self.link = None;
-        self.children.end_agents(IDLE_PERIOD);
+        self.children.end_agents(
+            Duration::from_millis(self.assignment.agent_exit_grace_ms),
+            IDLE_PERIOD,
+        );
         if let Err(e) = self.spec.cleanup() {
             tracing::warn!("removing the share's shared memory: {e}");
         }

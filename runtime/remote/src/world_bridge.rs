@@ -64,6 +64,8 @@ pub struct RemoteOptions {
     pub tick_deadline: Duration,
     /// How long a host may take to start its agents.
     pub join_timeout: Duration,
+    /// How long a host's agents get to exit by themselves when its share ends.
+    pub agent_exit_grace: Duration,
     /// Whether the hosts' agents pin themselves to CPUs by chain.
     pub pin_agents: bool,
     /// Whether the hosts tick and run their agents at real-time priority if they can.
@@ -553,6 +555,7 @@ impl RemoteHosts {
                 .collect(),
             tick_deadline_ms: (self.options.tick_deadline / 2).as_millis() as u64,
             join_timeout_ms: self.options.join_timeout.as_millis() as u64,
+            agent_exit_grace_ms: self.options.agent_exit_grace.as_millis() as u64,
             pin_agents: self.options.pin_agents,
             realtime_priority: self.options.realtime_priority,
             compiled_supervisors: self.options.compiled_supervisors.clone(),
@@ -1029,6 +1032,7 @@ mod tests {
             robots_override: None,
             tick_deadline: Duration::from_millis(300),
             join_timeout: Duration::from_secs(30),
+            agent_exit_grace: Duration::from_secs(5),
             pin_agents: true,
             realtime_priority: false,
             max_payload: codec::DEFAULT_MAX_PAYLOAD,

@@ -30,6 +30,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use swarm_contract::config::faults::{FaultKind, FaultSchedule};
 use swarm_contract::fault_plan::{FaultAction, FaultPlan};
+use swarm_contract::limits::Limits;
 use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::protocol::launcher_to_world::WorldCommand;
 use swarm_contract::protocol::resume::ResumePoint;
@@ -43,8 +44,6 @@ use swarm_world::recorder::Recorder;
 use crate::remote::{Link, Stop};
 use crate::report;
 
-/// How long the world waits for the launcher to apply the faults of a tick.
-const APPLY_TIMEOUT: Duration = Duration::from_secs(30);
 /// How often the world looks at joins and notices while it waits for agents before the first tick.
 const JOIN_POLL: Duration = Duration::from_millis(20);
 
@@ -94,6 +93,7 @@ pub struct FaultDriver {
     alive_mask: Vec<bool>,
     out_dir: PathBuf,
     join_timeout: Duration,
+    apply_timeout: Duration,
 }
 
 /// Reads the launcher's lines on standard input: a death notice reaches the transport at once (so the current
@@ -133,7 +133,7 @@ impl FaultDriver {
         seed: u64,
         commands: Receiver<WorldCommand>,
         out_dir: PathBuf,
-        join_timeout: Duration,
+        limits: &Limits,
     ) -> anyhow::Result<FaultDriver> {
         let robots = link.robots();
         if let Link::Local(local) = link {
@@ -165,7 +165,8 @@ impl FaultDriver {
             due,
             alive_mask: vec![true; robots],
             out_dir,
-            join_timeout,
+            join_timeout: limits.join_timeout(),
+            apply_timeout: limits.fault_apply_timeout(),
         })
     }
 
@@ -561,7 +562,7 @@ impl FaultDriver {
 
     /// Waits for `applied <tick>`, taking every other line on the way.
     fn wait_applied(&mut self, tick: u64) -> anyhow::Result<()> {
-        let deadline = Instant::now() + APPLY_TIMEOUT;
+        let deadline = Instant::now() + self.apply_timeout;
         loop {
             if let Some(i) = self.applied.iter().position(|&t| t == tick) {
                 self.applied.swap_remove(i);
@@ -572,7 +573,9 @@ impl FaultDriver {
                 Ok(command) => self.take(command),
                 Err(RecvTimeoutError::Timeout) => {
                     bail!(
-                        "the launcher did not apply the faults of tick {tick} within {APPLY_TIMEOUT:?}"
+                        "the launcher did not apply the faults of tick {tick} within {:?} (limit \
+                         fault_apply_timeout_ms)",
+                        self.apply_timeout
                     )
                 }
                 Err(RecvTimeoutError::Disconnected) => {

@@ -98,10 +98,10 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .collect();
 
     let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;
+    let mut limits = experiment.framework.limits;
+    limits.apply(&args.limits)?;
     let mut link_config = LinkConfig::new(robots as u32);
-    if let Some(ms) = args.tick_deadline_ms {
-        link_config.tick_deadline = Duration::from_millis(ms);
-    }
+    link_config.tick_deadline = limits.tick_deadline();
     link_config.pin_chains = experiment.framework.pin_agents;
     link_config.realtime = priority::tick_at_realtime(experiment.framework.realtime_priority);
     let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
@@ -116,7 +116,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 plan,
                 args,
                 controllers,
-                link_config.tick_deadline,
+                &limits,
                 link_config.pin_chains,
                 experiment.framework.realtime_priority,
             )?;
@@ -130,7 +130,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         args.seed,
         launcher,
         args.out.clone(),
-        Duration::from_millis(args.join_timeout_ms),
+        &limits,
     )?;
     let mut recorder = Recorder::create(&args.out, &world, &[0])?;
     recorder.record(&world)?;
@@ -204,6 +204,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         "tick_micros_p50": percentile(&mut tick_micros, 0.50),
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
         "real_time": pacer.summary(ticks),
+        "limits": limits,
     });
     if let Some(object) = extra.as_object_mut() {
         object.insert("alive_final".into(), faults.alive_count().into());

@@ -10,11 +10,11 @@
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
+use swarm_contract::limits::Limits;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame, SupervisorSnapshot};
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::run_dir;
 use swarm_contract::transport::{CommandStatus, TickOutcome, WorldLink};
-use swarm_remote::codec::DEFAULT_MAX_PAYLOAD;
 use swarm_remote::orders::OrderAction;
 use swarm_remote::plan::HostsPlan;
 use swarm_remote::world_bridge::{HostEvent, RemoteHosts, RemoteOptions, RobotNews};
@@ -66,7 +66,7 @@ impl Link {
         plan: HostsPlan,
         args: &WorldArgs,
         controllers: Vec<String>,
-        tick_deadline: Duration,
+        limits: &Limits,
         pin_agents: bool,
         realtime_priority: bool,
     ) -> anyhow::Result<Link> {
@@ -82,11 +82,12 @@ impl Link {
             config,
             seed: args.seed,
             robots_override: args.robots,
-            tick_deadline,
-            join_timeout: Duration::from_millis(args.join_timeout_ms),
+            tick_deadline: limits.tick_deadline(),
+            join_timeout: limits.join_timeout(),
+            agent_exit_grace: limits.agent_exit_grace(),
             pin_agents,
             realtime_priority,
-            max_payload: DEFAULT_MAX_PAYLOAD,
+            max_payload: limits.max_host_message(),
             compiled_supervisors,
         };
         let run = SystemTime::now()

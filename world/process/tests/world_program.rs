@@ -20,8 +20,7 @@ fn world_args(dir: &Path, config: &Path) -> WorldArgs {
         ticks: 10,
         robots: None,
         out: dir.join("run"),
-        tick_deadline_ms: None,
-        join_timeout_ms: 1_000,
+        limits: vec!["join_timeout_ms=1000".into()],
         real_time: false,
         faults: Vec::new(),
     }

@@ -117,6 +117,7 @@ pub fn thesis_example() -> Experiment {
             threads: 0,
             pin_agents: true,
             realtime_priority: true,
+            limits: Default::default(),
             length_seconds: 0.0,
             ticks_per_second: 20,
             random_seed: Some(124),

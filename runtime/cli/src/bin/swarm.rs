@@ -58,12 +58,19 @@ enum Commands {
         /// Run directory (default: runs/<config name>-<unix seconds>).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Milliseconds a tick waits for a missing command before it goes on without it.
+        /// Milliseconds a tick waits for a missing command before it goes on without it (the same as
+        /// --limit tick_deadline_ms=MS; default 500).
         #[arg(long = "tick-deadline-ms")]
         tick_deadline_ms: Option<u64>,
-        /// Milliseconds the run waits for its robots (or hosts) to join before it gives up (default 120000).
+        /// Milliseconds the run waits for its robots (or hosts) to join before it gives up (the same as
+        /// --limit join_timeout_ms=MS; default 120000).
         #[arg(long = "join-timeout-ms")]
         join_timeout_ms: Option<u64>,
+        /// A timeout or size limit, overriding the configuration's <system> attribute of the same name
+        /// (repeatable): tick_deadline_ms, join_timeout_ms, world_ready_timeout_ms, agent_exit_grace_ms,
+        /// fault_apply_timeout_ms, ctl_reply_timeout_ms, max_host_message_bytes (docs/configuration.md).
+        #[arg(long = "limit", value_name = "NAME=VALUE")]
+        limits: Vec<String>,
         /// Do not draw a progress bar.
         #[arg(long)]
         no_progress: bool,
@@ -274,6 +281,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
             tick_deadline_ms,
             join_timeout_ms,
+            mut limits,
             no_progress,
             real_time,
             faults,
@@ -290,8 +298,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 seed,
                 out,
                 progress: !no_progress,
-                tick_deadline: tick_deadline_ms.map(Duration::from_millis),
-                join_timeout: join_timeout_ms.map(Duration::from_millis),
+                limits: {
+                    let shorthands = [
+                        ("tick_deadline_ms", tick_deadline_ms),
+                        ("join_timeout_ms", join_timeout_ms),
+                    ];
+                    for (name, value) in shorthands {
+                        if let Some(value) = value {
+                            limits.push(format!("{name}={value}"));
+                        }
+                    }
+                    limits
+                },
                 real_time,
                 faults,
                 hosts,

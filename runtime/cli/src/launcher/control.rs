@@ -16,9 +16,6 @@ use std::time::Duration;
 
 use swarm_contract::run_dir::CONTROL_SOCKET;
 
-/// How long a request waits for the supervision loop's answer.
-const REPLY_TIMEOUT: Duration = Duration::from_secs(10);
-
 /// A request to the launcher of a live run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CtlCommand {
@@ -116,8 +113,9 @@ pub struct ControlServer {
 }
 
 impl ControlServer {
-    /// Listens on `<run_dir>/control.sock`.
-    pub fn listen(run_dir: &Path) -> std::io::Result<ControlServer> {
+    /// Listens on `<run_dir>/control.sock`; a request waits up to `reply_timeout` for the supervision loop's
+    /// answer ([`Limits::ctl_reply_timeout_ms`](swarm_contract::limits::Limits)).
+    pub fn listen(run_dir: &Path, reply_timeout: Duration) -> std::io::Result<ControlServer> {
         let path = run_dir.join(CONTROL_SOCKET);
         // A socket left by a killed launcher would make bind fail.
         let _ = std::fs::remove_file(&path);
@@ -131,7 +129,7 @@ impl ControlServer {
                     break;
                 }
                 if let Ok(stream) = stream {
-                    serve(stream, &sender);
+                    serve(stream, &sender, reply_timeout);
                 }
             }
         });
@@ -158,8 +156,8 @@ impl Drop for ControlServer {
 }
 
 /// Handles one connection: one request line, one answer.
-fn serve(mut stream: UnixStream, requests: &Sender<CtlRequest>) {
-    let _ = stream.set_read_timeout(Some(REPLY_TIMEOUT));
+fn serve(mut stream: UnixStream, requests: &Sender<CtlRequest>, reply_timeout: Duration) {
+    let _ = stream.set_read_timeout(Some(reply_timeout));
     let mut line = String::new();
     let Ok(reader) = stream.try_clone() else {
         return;
@@ -175,7 +173,7 @@ fn serve(mut stream: UnixStream, requests: &Sender<CtlRequest>) {
                 Err("the run is ending".to_owned())
             } else {
                 answer
-                    .recv_timeout(REPLY_TIMEOUT)
+                    .recv_timeout(reply_timeout)
                     .unwrap_or_else(|_| Err("the launcher did not answer".to_owned()))
             }
         }
@@ -219,10 +217,12 @@ pub fn request(run: &Path, command: CtlCommand) -> Result<String, CtlError> {
 mod tests {
     use super::*;
 
+    const REPLY_TIMEOUT: Duration = Duration::from_secs(10);
+
     #[test]
     fn a_request_reaches_the_supervision_loop_and_its_answer_the_client() {
         let dir = tempfile::tempdir().expect("temp dir");
-        let server = ControlServer::listen(dir.path()).expect("listening");
+        let server = ControlServer::listen(dir.path(), REPLY_TIMEOUT).expect("listening");
         let client = {
             let dir = dir.path().to_path_buf();
             std::thread::spawn(move || request(&dir, CtlCommand::Freeze(3)))

@@ -41,6 +41,7 @@ use restart::RestartTracker;
 use swarm_contract::config::faults::{FaultKind, FaultSchedule};
 use swarm_contract::config::{ConfigErrors, Experiment};
 use swarm_contract::fault_plan::FaultPlan;
+use swarm_contract::limits::LimitError;
 use swarm_contract::process::binaries::{Binaries, BinariesError};
 use swarm_contract::process::children;
 use swarm_contract::process::children::Children;
@@ -52,15 +53,10 @@ use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE}
 use swarm_contract::transport::{self, RunSpec};
 use swarm_remote::plan::{HostsArgs, HostsError, HostsPlan};
 
-/// How long the launcher waits for the world to create its services.
-const WORLD_READY_TIMEOUT: Duration = Duration::from_secs(60);
 /// How often the supervision loop looks at its children when the world is quiet.
 const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
 /// Lines of an agent's log quoted when it fails to start.
 const LOG_LINES_QUOTED: usize = 8;
-
-/// How long a run waits for its agents, or its hosts, to join before it gives up.
-pub const DEFAULT_JOIN_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// What `swarm run` was asked to do.
 #[derive(Debug, Clone, Default)]
@@ -77,10 +73,9 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Show a progress bar on the terminal.
     pub progress: bool,
-    /// How long a tick waits for a missing command (default: the transport's).
-    pub tick_deadline: Option<Duration>,
-    /// How long the run waits for its agents or hosts to join (default [`DEFAULT_JOIN_TIMEOUT`]).
-    pub join_timeout: Option<Duration>,
+    /// Limits overriding the configuration's, as `NAME=VALUE` (`swarm run --limit`; see
+    /// [`Limits`](swarm_contract::limits::Limits)).
+    pub limits: Vec<String>,
     /// Pace the ticks at the configuration's ticks_per_second (real-time mode) instead of running flat out.
     pub real_time: bool,
     /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
@@ -165,8 +160,13 @@ pub enum LaunchError {
         when: String,
     },
     /// The world did not say `ready` in time.
-    #[error("the world process did not create its services within {0:?}")]
+    #[error(
+        "the world process did not create its services within {0:?} (limit world_ready_timeout_ms)"
+    )]
     WorldNotReady(Duration),
+    /// A `--limit` override is invalid.
+    #[error("--limit: {0}")]
+    Limit(#[from] LimitError),
     /// An agent failed before the first tick.
     #[error("robot {robot} ({id}) failed to start ({status}):\n{log}")]
     AgentFailed {
@@ -207,6 +207,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         Some(n) => experiment.with_robot_count(n)?,
         None => experiment,
     };
+    let mut limits = experiment.framework.limits;
+    limits.apply(&options.limits)?;
     let roster = experiment.arena.robots();
     if roster.is_empty() {
         return Err(LaunchError::NoRobots {
@@ -274,11 +276,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         ticks,
         robots: options.robots,
         out: out_dir.clone(),
-        tick_deadline_ms: options.tick_deadline.map(|d| d.as_millis() as u64),
-        join_timeout_ms: options
-            .join_timeout
-            .unwrap_or(DEFAULT_JOIN_TIMEOUT)
-            .as_millis() as u64,
+        limits: options.limits.clone(),
         real_time: options.real_time,
         faults: options.faults.clone(),
     };
@@ -295,14 +293,19 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let reports = follow_reports(world.stdout.take());
     children.world = Some(world);
 
-    wait_ready(&mut children, &reports, robots)?;
+    wait_ready(
+        &mut children,
+        &reports,
+        robots,
+        limits.world_ready_timeout(),
+    )?;
     // With hosts, each host daemon starts its own robots' agents; the world waits for them.
     if let Some(placement) = &placement {
         for share in placement {
             tracing::info!(host = share.name, robots = share.robots.len(), "placed");
         }
     }
-    let control = match ControlServer::listen(&out_dir) {
+    let control = match ControlServer::listen(&out_dir, limits.ctl_reply_timeout()) {
         Ok(server) => Some(server),
         Err(e) => {
             tracing::warn!(
@@ -350,6 +353,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         faults: Vec::new(),
         pending_restarts: Vec::new(),
         reaped: Vec::new(),
+        agent_exit_grace: limits.agent_exit_grace(),
         host_names: placement
             .iter()
             .flatten()
@@ -476,8 +480,9 @@ fn wait_ready(
     children: &mut Children,
     reports: &Receiver<WorldReport>,
     robots: u32,
+    timeout: Duration,
 ) -> Result<(), LaunchError> {
-    let deadline = Instant::now() + WORLD_READY_TIMEOUT;
+    let deadline = Instant::now() + timeout;
     loop {
         match reports.recv_timeout(SUPERVISION_PERIOD) {
             Ok(WorldReport::Ready { robots: ready }) if ready == robots => return Ok(()),
@@ -500,7 +505,7 @@ fn wait_ready(
             });
         }
         if Instant::now() > deadline {
-            return Err(LaunchError::WorldNotReady(WORLD_READY_TIMEOUT));
+            return Err(LaunchError::WorldNotReady(timeout));
         }
     }
 }
@@ -552,6 +557,8 @@ struct Supervision {
     /// The hosts of a multi-host run, in placement order (empty for a local run).
     host_names: Vec<String>,
     control: Option<ControlServer>,
+    /// How long agents get to exit by themselves after the run.
+    agent_exit_grace: Duration,
 }
 
 impl Supervision {
@@ -684,7 +691,9 @@ impl Supervision {
     /// Lets agents exit by themselves (the world's end tells them), then kills the rest.
     fn collect_agents(&mut self) {
         self.thaw_all();
-        let stragglers = self.children.end_agents(SUPERVISION_PERIOD);
+        let stragglers = self
+            .children
+            .end_agents(self.agent_exit_grace, SUPERVISION_PERIOD);
         if stragglers > 0 {
             tracing::warn!(stragglers, "agents did not exit after the run; killed them");
         }

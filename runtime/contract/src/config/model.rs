@@ -152,6 +152,9 @@ pub struct Framework {
     /// `<system realtime_priority>` (ours): whether the world's ticking thread and the agents run at real-time
     /// priority when the system allows it; true when absent.
     pub realtime_priority: bool,
+    /// The run's timeouts and size limits, with `<system>`'s attributes of the same names applied (each process
+    /// applies the command line's overrides on top).
+    pub limits: crate::limits::Limits,
     /// `<experiment length>` in seconds; 0 means no limit (stop via loop functions).
     pub length_seconds: f64,
     /// `<experiment ticks_per_second>`: control steps per simulated second, always > 0.

@@ -26,9 +26,6 @@ pub fn spawn(command: &mut Command) -> std::io::Result<Child> {
     command.spawn()
 }
 
-/// How long agents get to exit by themselves once their run ended, before they are killed.
-pub const AGENT_EXIT_GRACE: Duration = Duration::from_secs(5);
-
 /// Sends `signal` to a child; a child that already exited is not an error.
 pub fn signal(child: &Child, signal: Signal) {
     if let Ok(pid) = i32::try_from(child.id()) {
@@ -85,11 +82,11 @@ impl Children {
         self.agents.iter().filter(|a| a.is_some()).count()
     }
 
-    /// Gives the agents up to [`AGENT_EXIT_GRACE`] to exit by themselves (reaping every `period`), then kills
-    /// the rest; returns how many had to be killed. Launchers and host daemons end their agents this way after
-    /// the run's shared memory told them the run is over.
-    pub fn end_agents(&mut self, period: Duration) -> usize {
-        let deadline = Instant::now() + AGENT_EXIT_GRACE;
+    /// Gives the agents up to `grace` ([`Limits::agent_exit_grace_ms`](crate::limits::Limits)) to exit by
+    /// themselves (reaping every `period`), then kills the rest; returns how many had to be killed. Launchers and
+    /// host daemons end their agents this way after the run's shared memory told them the run is over.
+    pub fn end_agents(&mut self, grace: Duration, period: Duration) -> usize {
+        let deadline = Instant::now() + grace;
         while self.agents_running() > 0 && Instant::now() < deadline {
             self.reap_agents();
             std::thread::sleep(period);

@@ -36,12 +36,10 @@ pub struct WorldArgs {
     /// Run directory the world writes its records into.
     #[arg(long)]
     pub out: PathBuf,
-    /// Milliseconds a tick waits for missing commands before it goes on without them.
-    #[arg(long = "tick-deadline-ms")]
-    pub tick_deadline_ms: Option<u64>,
-    /// Milliseconds the world waits for every agent to join before the first tick.
-    #[arg(long = "join-timeout-ms", default_value_t = 120_000)]
-    pub join_timeout_ms: u64,
+    /// Limits overriding the configuration's `<system>` ones, as NAME=VALUE (repeatable; see
+    /// [`Limits`](crate::limits::Limits)).
+    #[arg(long = "limit", value_name = "NAME=VALUE")]
+    pub limits: Vec<String>,
     /// Pace the ticks at the configuration's ticks_per_second instead of running as fast as possible.
     #[arg(long = "real-time")]
     pub real_time: bool,
@@ -63,14 +61,12 @@ impl WorldArgs {
             self.ticks.to_string(),
             "--out".into(),
             self.out.display().to_string(),
-            "--join-timeout-ms".into(),
-            self.join_timeout_ms.to_string(),
         ]);
         if let Some(robots) = self.robots {
             args.extend(["--robots".into(), robots.to_string()]);
         }
-        if let Some(ms) = self.tick_deadline_ms {
-            args.extend(["--tick-deadline-ms".into(), ms.to_string()]);
+        for limit in &self.limits {
+            args.extend(["--limit".into(), limit.clone()]);
         }
         if self.real_time {
             args.push("--real-time".into());
@@ -154,8 +150,7 @@ mod tests {
             ticks: 600,
             robots: Some(40),
             out: PathBuf::from("runs/x"),
-            tick_deadline_ms: Some(250),
-            join_timeout_ms: 5_000,
+            limits: vec!["tick_deadline_ms=250".into(), "join_timeout_ms=5000".into()],
             real_time: true,
             faults: vec!["kill robots=3 tick=50".into()],
         };

@@ -28,7 +28,9 @@ use std::process::Command;
 pub use agent::{AgentLink, Tick};
 pub use run::{RUN_ROOTS_DIR, RunSpec};
 pub use sync_block::MAX_ROBOTS;
-pub use world::{CommandStatus, DeathNotices, LinkConfig, TickOutcome, WorldLink};
+pub use world::{
+    CommandStatus, DEFAULT_TICK_DEADLINE, DeathNotices, LinkConfig, TickOutcome, WorldLink,
+};
 
 /// Whether the world has ended `run` (or its sync block is gone): an agent exiting now exits with the run, not
 /// before it.

@@ -1,9 +1,10 @@
-//! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>`,
+//! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>` and the run's [`Limits`],
 //! `<experiment length ticks_per_second random_seed>` and `<hosts>` (checked here, read by
 //! [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
 
 use super::Ctx;
 use crate::config::model::{Element, Framework, Location};
+use crate::limits::Limits;
 
 const CHILDREN: &[&str] = &["system", "experiment", "profiling", "hosts"];
 
@@ -13,6 +14,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     let mut threads = 0;
     let mut pin_agents = true;
     let mut realtime_priority = true;
+    let mut limits = Limits::default();
     let mut experiment: Option<(&Element, Location)> = None;
     let mut system_at: Option<Location> = None;
     for child in &el.children {
@@ -22,15 +24,21 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
                     ctx.duplicate(child, &el.name, first);
                 }
                 system_at = Some(child.location);
-                ctx.unknown_attributes(
-                    child,
-                    &[
-                        "threads",
-                        "method",
-                        "pin_threads_to_cores",
-                        "realtime_priority",
-                    ],
-                );
+                let mut known = vec![
+                    "threads",
+                    "method",
+                    "pin_threads_to_cores",
+                    "realtime_priority",
+                ];
+                known.extend(Limits::NAMES);
+                ctx.unknown_attributes(child, &known);
+                for name in Limits::NAMES {
+                    if let Some(attribute) = child.attributes.get(name)
+                        && let Err(e) = limits.set(name, &attribute.value)
+                    {
+                        ctx.error(attribute.location, format!("in <system>: {e}"), None);
+                    }
+                }
                 threads = ctx.attr(child, "threads").unwrap_or(0);
                 pin_agents = ctx.attr(child, "pin_threads_to_cores").unwrap_or(true);
                 realtime_priority = ctx.attr(child, "realtime_priority").unwrap_or(true);
@@ -96,6 +104,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
         threads,
         pin_agents,
         realtime_priority,
+        limits,
         length_seconds,
         ticks_per_second,
         random_seed,
