@@ -5,7 +5,7 @@
 //! agents and to pass the flags on; the world resolves the same plan from the same flags and configuration, so
 //! both always agree on the placement.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Args;
@@ -13,7 +13,6 @@ use clap::Args;
 use crate::keys::check_host_name;
 use crate::session::{DEFAULT_LEASE, DEFAULT_LISTEN, ZenohOptions};
 use crate::world_bridge::HostShare;
-use swarm_contract::config::ConfigErrors;
 use swarm_contract::config::hosts::HostsConfig;
 use swarm_contract::config::hosts::TlsFileError;
 
@@ -47,9 +46,6 @@ impl HostsArgs {
 /// Why the hosts of a run cannot be resolved.
 #[derive(Debug, thiserror::Error)]
 pub enum HostsError {
-    /// The experiment's `<hosts>` is invalid.
-    #[error("{0}")]
-    Config(#[from] ConfigErrors),
     /// `--hosts` is malformed.
     #[error("--hosts {value}: {reason}")]
     Flag {
@@ -139,10 +135,13 @@ pub fn parse_hosts_flag(value: &str) -> Result<Vec<WeightedHost>, HostsError> {
 }
 
 impl HostsPlan {
-    /// The plan of a run: `--hosts` over the experiment's `<hosts>`; `None` when neither names a host (a local run).
-    pub fn resolve(config: &Path, args: &HostsArgs) -> Result<Option<HostsPlan>, HostsError> {
-        let element = HostsConfig::load(config)?;
-        let hosts = match (&args.hosts, &element) {
+    /// The plan of a run: `--hosts` over the experiment's `<hosts>` (`element`, as the configuration parser read
+    /// it); `None` when neither names a host (a local run).
+    pub fn resolve(
+        element: Option<&HostsConfig>,
+        args: &HostsArgs,
+    ) -> Result<Option<HostsPlan>, HostsError> {
+        let hosts = match (&args.hosts, element) {
             (Some(flag), _) => parse_hosts_flag(flag)?,
             (None, Some(element)) => element
                 .hosts
@@ -155,10 +154,7 @@ impl HostsPlan {
             (None, None) => return Ok(None),
         };
         let mut listen = if args.listen.is_empty() {
-            element
-                .as_ref()
-                .map(|e| e.listen.clone())
-                .unwrap_or_default()
+            element.map(|e| e.listen.clone()).unwrap_or_default()
         } else {
             args.listen.clone()
         };
@@ -170,11 +166,11 @@ impl HostsPlan {
             zenoh.lease = element
                 .lease_ms
                 .map_or(DEFAULT_LEASE, Duration::from_millis);
-            zenoh.config_file = element.zenoh_config;
-            zenoh.user = element.user;
-            zenoh.credentials_file = element.credentials_file;
-            zenoh.tls = element.tls;
-            if let Some(path) = element.password_file {
+            zenoh.config_file = element.zenoh_config.clone();
+            zenoh.user = element.user.clone();
+            zenoh.credentials_file = element.credentials_file.clone();
+            zenoh.tls = element.tls.clone();
+            if let Some(path) = element.password_file.clone() {
                 let text = std::fs::read_to_string(&path)
                     .map_err(|source| HostsError::Password { path, source })?;
                 zenoh.password = Some(text.trim_end_matches(['\r', '\n']).to_owned());
@@ -241,6 +237,9 @@ pub fn place(robots: u32, hosts: &[WeightedHost]) -> Vec<HostShare> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
+
+    use swarm_contract::config::Experiment;
 
     fn hosts(spec: &str) -> Vec<WeightedHost> {
         parse_hosts_flag(spec).expect("valid")
@@ -277,14 +276,18 @@ mod tests {
         assert_eq!(sizes(&place(1, &hosts("a,b"))), [("a".into(), 1)]);
     }
 
-    fn experiment(dir: &Path, hosts: &str) -> PathBuf {
+    /// The `<hosts>` of an experiment written into `dir`, as the configuration parser reads it.
+    fn experiment(dir: &Path, hosts: &str) -> Option<HostsConfig> {
         let path = dir.join("x.argos");
         let text = format!(
             "<argos-configuration><framework><experiment length=\"1\" ticks_per_second=\"10\" />{hosts}\
-             </framework></argos-configuration>"
+             </framework><controllers><test_controller id=\"c\" library=\"agent\"><actuators/><sensors/>\
+             <params/></test_controller></controllers><arena size=\"1,1,1\" center=\"0,0,0.5\"/>\
+             <physics_engines><dynamics2d id=\"d\"/></physics_engines><media/></argos-configuration>"
         );
         std::fs::write(&path, text).expect("write");
-        path
+        let (experiment, _) = Experiment::load(&path).expect("a valid experiment");
+        experiment.framework.hosts
     }
 
     #[test]
@@ -292,7 +295,7 @@ mod tests {
         let dir = tempfile::tempdir().expect("a temporary directory");
         let local = experiment(dir.path(), "");
         assert!(
-            HostsPlan::resolve(&local, &HostsArgs::default())
+            HostsPlan::resolve(local.as_ref(), &HostsArgs::default())
                 .expect("valid")
                 .is_none()
         );
@@ -302,7 +305,7 @@ mod tests {
             dir.path(),
             r#"<hosts listen="tcp/10.0.0.1:7447" lease_ms="700" user="swarm" password_file="pw"><host name="a" /></hosts>"#,
         );
-        let plan = HostsPlan::resolve(&config, &HostsArgs::default())
+        let plan = HostsPlan::resolve(config.as_ref(), &HostsArgs::default())
             .expect("valid")
             .expect("hosts");
         assert_eq!(plan.hosts, hosts("a"));
@@ -314,7 +317,7 @@ mod tests {
             hosts: Some("b:2,c".into()),
             listen: vec!["tcp/127.0.0.1:9000".into()],
         };
-        let plan = HostsPlan::resolve(&config, &args)
+        let plan = HostsPlan::resolve(config.as_ref(), &args)
             .expect("valid")
             .expect("hosts");
         assert_eq!(plan.hosts, hosts("b:2,c"));
@@ -347,7 +350,7 @@ mod tests {
             hosts: None,
             listen: vec!["tls/127.0.0.1:9000".into()],
         };
-        let err = HostsPlan::resolve(&plain, &args)
+        let err = HostsPlan::resolve(plain.as_ref(), &args)
             .expect_err("no certificate")
             .to_string();
         assert!(
@@ -359,7 +362,7 @@ mod tests {
             dir.path(),
             r#"<hosts listen="tls/127.0.0.1:9000" tls_certificate="w.pem" tls_private_key="w.key"><host name="a" /></hosts>"#,
         );
-        let err = HostsPlan::resolve(&missing, &HostsArgs::default())
+        let err = HostsPlan::resolve(missing.as_ref(), &HostsArgs::default())
             .expect_err("missing files")
             .to_string();
         assert!(

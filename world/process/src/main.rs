@@ -83,12 +83,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     };
     let mut world = World::new(&experiment, args.seed)?;
     let robots = world.robot_count();
-    let controller_ids: Vec<&str> = experiment
-        .controllers
-        .iter()
-        .map(|c| c.id.as_str())
-        .collect();
-    let schedule = FaultSchedule::load(&args.config, &args.faults, robots as u32, &controller_ids)?;
+    let schedule = FaultSchedule::for_run(&experiment, &args.faults, robots as u32)?;
     world.set_dead_bodies(schedule.dead_bodies);
     let roster: Vec<(String, String)> = experiment
         .arena
@@ -104,7 +99,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     link_config.tick_deadline = limits.tick_deadline();
     link_config.pin_chains = experiment.framework.pin_agents;
     link_config.realtime = priority::tick_at_realtime(experiment.framework.realtime_priority);
-    let (mut link, launcher) = match HostsPlan::resolve(&args.config, hosts)? {
+    let (mut link, launcher) = match HostsPlan::resolve(experiment.framework.hosts.as_ref(), hosts)?
+    {
         None => {
             let link = WorldLink::create(&run, link_config)?;
             let launcher = faults::follow_launcher(Some(link.death_notices()));

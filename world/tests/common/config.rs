@@ -118,6 +118,7 @@ pub fn thesis_example() -> Experiment {
             pin_agents: true,
             realtime_priority: true,
             limits: Default::default(),
+            hosts: None,
             length_seconds: 0.0,
             ticks_per_second: 20,
             random_seed: Some(124),
@@ -166,5 +167,6 @@ pub fn thesis_example() -> Experiment {
             location: at(66),
         },
         media: Media::default(),
+        faults: Default::default(),
     }
 }

@@ -230,8 +230,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .ticks
         .or(experiment.framework.max_ticks())
         .unwrap_or(0);
-    let placement =
-        HostsPlan::resolve(&options.config, &options.hosts)?.map(|plan| plan.place(robots));
+    let placement = HostsPlan::resolve(experiment.framework.hosts.as_ref(), &options.hosts)?
+        .map(|plan| plan.place(robots));
     let out_dir = run_dir::create(options.out.as_deref(), &options.config)
         .map_err(io("creating the run directory"))?;
     let binaries = Binaries::locate()?;
@@ -242,12 +242,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         iox_root: spec.root_dir().to_path_buf(),
     };
     let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
-    let controller_ids: Vec<&str> = experiment
-        .controllers
-        .iter()
-        .map(|c| c.id.as_str())
-        .collect();
-    let schedule = FaultSchedule::load(&options.config, &options.faults, robots, &controller_ids)?;
+    let schedule = FaultSchedule::for_run(&experiment, &options.faults, robots)?;
     let ticks_per_second = experiment.framework.ticks_per_second;
     let mut startup = Vec::new();
     FaultPlan::new(&schedule, ticks_per_second, seed).due(

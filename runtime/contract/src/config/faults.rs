@@ -15,13 +15,12 @@
 //! the schedule (every error located, never a panic); the launcher and the world execute it
 //! ([`crate::fault_plan`]). docs/faults.md explains the semantics.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::diagnostic::{ConfigErrors, Diagnostic};
-use super::model::{Attribute, Element, Location};
+use super::model::{Attribute, Element, Experiment, Location};
 use super::parse::Ctx;
 use super::values::Value;
-use super::xml::parse_tree;
 
 /// Name of the extension section.
 pub const SECTION: &str = "faults";
@@ -188,33 +187,16 @@ pub struct FaultSchedule {
 }
 
 impl FaultSchedule {
-    /// Reads the `<faults>` section of `config` (if any) and the `--fault` texts, and checks robot indices
-    /// against `robots` and controller ids against `controllers`. Every error is located.
-    pub fn load(
-        config: &Path,
+    /// The schedule of one run: the experiment's `<faults>` (read with the rest of the configuration) and the
+    /// `--fault` texts, with robot indices checked against `robots` (the run's count, after `--robots`) and
+    /// controller ids against the experiment's. Every error is located.
+    pub fn for_run(
+        experiment: &Experiment,
         cli: &[String],
         robots: u32,
-        controllers: &[&str],
     ) -> Result<FaultSchedule, ConfigErrors> {
         let mut errors = Vec::new();
-        let mut schedule = FaultSchedule::default();
-        let located = |d: Diagnostic| ConfigErrors { errors: vec![d] };
-        let text = std::fs::read_to_string(config).map_err(|e| {
-            located(Diagnostic::new(
-                config.to_path_buf(),
-                Location::default(),
-                format!("cannot read the file: {e}"),
-            ))
-        })?;
-        let root = parse_tree(config, &text).map_err(located)?;
-        if let Some(section) = root.children.iter().find(|c| c.name == SECTION) {
-            let mut ctx = Ctx::new(config);
-            let part = read_section(&mut ctx, section);
-            errors.extend(ctx.into_errors());
-            schedule.faults.extend(part.faults);
-            schedule.restarts.extend(part.restarts);
-            schedule.dead_bodies = part.dead_bodies;
-        }
+        let mut schedule = experiment.faults.clone();
         for (i, text) in cli.iter().enumerate() {
             let path = PathBuf::from(format!("--fault #{}", i + 1));
             let mut ctx = Ctx::new(&path);
@@ -224,7 +206,12 @@ impl FaultSchedule {
             }
             errors.extend(ctx.into_errors());
         }
-        errors.extend(schedule.check(robots, controllers));
+        let controllers: Vec<&str> = experiment
+            .controllers
+            .iter()
+            .map(|c| c.id.as_str())
+            .collect();
+        errors.extend(schedule.check(robots, &controllers));
         if errors.is_empty() {
             Ok(schedule)
         } else {
@@ -283,12 +270,8 @@ impl FaultSchedule {
     }
 }
 
-/// Checks a `<faults>` section during the normal configuration load, so its errors come with all the others.
-pub(crate) fn check_section(ctx: &mut Ctx, el: &Element) {
-    read_section(ctx, el);
-}
-
-fn read_section(ctx: &mut Ctx, el: &Element) -> FaultSchedule {
+/// Reads a `<faults>` section during the normal configuration load, so its errors come with all the others.
+pub(crate) fn read_section(ctx: &mut Ctx, el: &Element) -> FaultSchedule {
     ctx.unknown_attributes(el, &["dead_bodies"]);
     let mut schedule = FaultSchedule {
         dead_bodies: dead_bodies(ctx, el),
@@ -652,19 +635,23 @@ fn element_from_words(text: &str) -> Result<Element, (u32, String)> {
 mod tests {
     use super::*;
 
-    fn config(faults: &str) -> tempfile::NamedTempFile {
+    /// The sections after `<faults>` that make the experiment complete (one controller, `oa`).
+    const REST: &str = "<controllers><test_controller id=\"oa\" library=\"agent\"><actuators/><sensors/>\
+        <params/></test_controller></controllers>\n<arena size=\"1,1,1\" center=\"0,0,0.5\"/>\n\
+        <physics_engines><dynamics2d id=\"d\"/></physics_engines>\n<media/>";
+
+    /// An experiment whose `<faults>` section starts on line 3.
+    fn experiment(faults: &str) -> Result<Experiment, ConfigErrors> {
         let text = format!(
-            "<argos-configuration>\n<framework><experiment length=\"10\" ticks_per_second=\"10\"/></framework>\n{faults}\n</argos-configuration>\n"
+            "<argos-configuration>\n<framework><experiment length=\"10\" ticks_per_second=\"10\"/></framework>\n\
+             {faults}\n{REST}\n</argos-configuration>\n"
         );
-        let mut file = tempfile::NamedTempFile::new().expect("temp file");
-        std::io::Write::write_all(&mut file, text.as_bytes()).expect("written");
-        file
+        Experiment::parse("x.argos", &text).map(|(experiment, _)| experiment)
     }
 
     fn load(faults: &str, cli: &[&str]) -> Result<FaultSchedule, ConfigErrors> {
-        let file = config(faults);
         let cli: Vec<String> = cli.iter().map(|s| s.to_string()).collect();
-        FaultSchedule::load(file.path(), &cli, 40, &["oa"])
+        FaultSchedule::for_run(&experiment(faults)?, &cli, 40)
     }
 
     #[test]
@@ -705,10 +692,9 @@ mod tests {
     }
 
     #[test]
-    fn errors_name_the_line_column_and_problem() {
-        let err = load(
+    fn errors_in_the_section_are_located_with_the_rest_of_the_configuration() {
+        let err = experiment(
             "<faults>\n  <kill robots=\"3\"/>\n  <kill robots=\"99\" tick=\"1\"/>\n  <explode tick=\"1\"/>\n</faults>",
-            &["freeze robots=2 tick=x"],
         )
         .unwrap_err()
         .to_string();
@@ -717,11 +703,21 @@ mod tests {
             "{err}"
         );
         assert!(
-            err.contains(":5:3: robot 99 does not exist: the run has 40 robots"),
+            err.contains(":6:3: unknown element <explode> in <faults>"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_run_checks_robot_indices_and_command_line_faults_with_their_locations() {
+        let err = load(
+            "<faults>\n  <kill robots=\"3\" tick=\"2\"/>\n  <kill robots=\"99\" tick=\"1\"/>\n</faults>",
+            &["freeze robots=2 tick=x"],
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
-            err.contains(":6:3: unknown element <explode> in <faults>"),
+            err.contains(":5:3: robot 99 does not exist: the run has 40 robots"),
             "{err}"
         );
         assert!(

@@ -16,14 +16,12 @@
 //! Each `<host>` has a `name` (as given to `swarm host --name`) and an optional integer `weight` (default 1):
 //! robots are shared in proportion to the weights. Without `<hosts>` every robot runs on the launcher's machine.
 //!
-//! The element is read here rather than in the typed model so that runs without it carry nothing of it; the
-//! framework parser only checks it (every error located) and [`HostsConfig::load`] reads it when a run needs it.
+//! The framework parser reads it with the rest of the configuration (every error located) into
+//! [`Framework::hosts`](super::Framework::hosts).
 
 use std::path::{Path, PathBuf};
 
-use super::diagnostic::{ConfigErrors, Diagnostic};
 use super::model::{Element, Location};
-use super::xml::parse_tree;
 
 /// Longest host name (it is one zenoh key chunk and part of log lines).
 pub const MAX_HOST_NAME: usize = 64;
@@ -145,40 +143,6 @@ const ATTRIBUTES: &[&str] = &[
     "tls_private_key",
     "tls_root_ca",
 ];
-
-impl HostsConfig {
-    /// Reads `<framework><hosts>` of an experiment file; `None` when it has none.
-    pub fn load(path: &Path) -> Result<Option<HostsConfig>, ConfigErrors> {
-        let located = |errors: Vec<(Location, String)>| ConfigErrors {
-            errors: errors
-                .into_iter()
-                .map(|(at, message)| Diagnostic::new(path.to_path_buf(), at, message))
-                .collect(),
-        };
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            located(vec![(
-                Location::default(),
-                format!("cannot read the file: {e}"),
-            )])
-        })?;
-        let root = parse_tree(path, &text).map_err(|d| ConfigErrors { errors: vec![d] })?;
-        let Some(element) = root
-            .children
-            .iter()
-            .filter(|c| c.name == "framework")
-            .flat_map(|f| f.children.iter())
-            .find(|c| c.name == "hosts")
-        else {
-            return Ok(None);
-        };
-        let base = path.parent().unwrap_or(Path::new("."));
-        let (config, errors) = parse(element, base);
-        match config {
-            Some(config) if errors.is_empty() => Ok(Some(config)),
-            _ => Err(located(errors)),
-        }
-    }
-}
 
 /// Parses a `<hosts>` element; relative paths are resolved against `base`. Returns the element (when usable)
 /// and every error found, located.
@@ -341,23 +305,28 @@ fn host(el: &Element, errors: &mut Vec<(Location, String)>) -> Option<HostEntry>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::ConfigErrors;
 
-    fn experiment(hosts: &str) -> String {
-        format!(
-            "<argos-configuration>\n<framework>\n<experiment length=\"10\" ticks_per_second=\"10\" />\n{hosts}\n</framework>\n</argos-configuration>\n"
-        )
-    }
-
-    /// Writes an experiment with `hosts` into `dir`; returns its path.
+    /// An experiment whose `<hosts>` starts on line 4, written into `dir`; returns its path.
     fn write_experiment(dir: &Path, hosts: &str) -> PathBuf {
         let path = dir.join("x.argos");
-        std::fs::write(&path, experiment(hosts)).expect("write");
+        let text = format!(
+            "<argos-configuration>\n<framework>\n<experiment length=\"10\" ticks_per_second=\"10\" />\n{hosts}\n\
+             </framework>\n<controllers><test_controller id=\"c\" library=\"agent\"><actuators/><sensors/>\
+             <params/></test_controller></controllers>\n<arena size=\"1,1,1\" center=\"0,0,0.5\"/>\n\
+             <physics_engines><dynamics2d id=\"d\"/></physics_engines>\n<media/>\n</argos-configuration>\n"
+        );
+        std::fs::write(&path, text).expect("write");
         path
+    }
+
+    fn read(path: &Path) -> Result<Option<HostsConfig>, ConfigErrors> {
+        crate::config::Experiment::load(path).map(|(experiment, _)| experiment.framework.hosts)
     }
 
     fn load(hosts: &str) -> Result<Option<HostsConfig>, ConfigErrors> {
         let dir = tempfile::tempdir().expect("a temporary directory");
-        HostsConfig::load(&write_experiment(dir.path(), hosts))
+        read(&write_experiment(dir.path(), hosts))
     }
 
     #[test]
@@ -368,7 +337,7 @@ mod tests {
             r#"<hosts listen="tcp/10.0.0.1:7447, tcp/10.0.1.1:7447" lease_ms="800" user="swarm" password_file="pw">
                      <host name="a" weight="3" /><host name="b" /></hosts>"#,
         );
-        let config = HostsConfig::load(&path).expect("valid").expect("present");
+        let config = read(&path).expect("valid").expect("present");
         assert_eq!(config.listen, ["tcp/10.0.0.1:7447", "tcp/10.0.1.1:7447"]);
         assert_eq!(config.lease_ms, Some(800));
         assert_eq!(config.password_file, Some(dir.path().join("pw")));
@@ -409,7 +378,7 @@ mod tests {
             dir.path(),
             r#"<hosts listen="tls/10.0.0.1:7447" tls_certificate="pki/world.pem" tls_private_key="pki/world.key" tls_root_ca="pki/ca.pem"><host name="a" /></hosts>"#,
         );
-        let config = HostsConfig::load(&path).expect("valid").expect("present");
+        let config = read(&path).expect("valid").expect("present");
         assert_eq!(
             config.tls,
             TlsFiles {

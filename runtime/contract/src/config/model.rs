@@ -117,6 +117,9 @@ pub struct Experiment {
     pub physics_engine: PhysicsEngine,
     /// `<media>`: LED, range-and-bearing and pheromone media.
     pub media: Media,
+    /// `<faults>`: the fault schedule and restart rules the configuration itself gives (empty without the
+    /// section); a run adds `--fault` texts with [`FaultSchedule::for_run`](super::faults::FaultSchedule::for_run).
+    pub faults: super::faults::FaultSchedule,
 }
 
 impl Experiment {
@@ -155,6 +158,8 @@ pub struct Framework {
     /// The run's timeouts and size limits, with `<system>`'s attributes of the same names applied (each process
     /// applies the command line's overrides on top).
     pub limits: crate::limits::Limits,
+    /// `<hosts>`: the machines the robots run on; `None` runs every robot on the launcher's machine.
+    pub hosts: Option<super::hosts::HostsConfig>,
     /// `<experiment length>` in seconds; 0 means no limit (stop via loop functions).
     pub length_seconds: f64,
     /// `<experiment ticks_per_second>`: control steps per simulated second, always > 0.

@@ -1,6 +1,5 @@
 //! `<framework>`: `<system threads pin_threads_to_cores realtime_priority>` and the run's [`Limits`],
-//! `<experiment length ticks_per_second random_seed>` and `<hosts>` (checked here, read by
-//! [`HostsConfig::load`](crate::config::hosts::HostsConfig::load)).
+//! `<experiment length ticks_per_second random_seed>` and `<hosts>` ([`crate::config::hosts`]).
 
 use super::Ctx;
 use crate::config::model::{Element, Framework, Location};
@@ -15,6 +14,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
     let mut pin_agents = true;
     let mut realtime_priority = true;
     let mut limits = Limits::default();
+    let mut hosts = None;
     let mut experiment: Option<(&Element, Location)> = None;
     let mut system_at: Option<Location> = None;
     for child in &el.children {
@@ -53,10 +53,11 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
                 None,
             ),
             "hosts" => {
-                let (_, errors) = crate::config::hosts::parse(child, std::path::Path::new("."));
+                let (parsed, errors) = crate::config::hosts::parse(child, ctx.base_dir());
                 for (at, message) in errors {
                     ctx.error(at, message, None);
                 }
+                hosts = parsed;
             }
             _ => ctx.unknown_element(child, &el.name, CHILDREN),
         }
@@ -105,6 +106,7 @@ pub(super) fn framework(ctx: &mut Ctx, el: &Element) -> Option<Framework> {
         pin_agents,
         realtime_priority,
         limits,
+        hosts,
         length_seconds,
         ticks_per_second,
         random_seed,

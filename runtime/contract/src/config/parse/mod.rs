@@ -52,6 +52,11 @@ impl Ctx {
         }
     }
 
+    /// The folder relative paths in the file are resolved against.
+    pub(crate) fn base_dir(&self) -> &Path {
+        self.path.parent().unwrap_or(Path::new(""))
+    }
+
     /// The file being read.
     pub(crate) fn path(&self) -> &Path {
         &self.path
@@ -325,9 +330,9 @@ fn experiment(ctx: &mut Ctx, root: &Element, path: &Path) -> Option<Experiment> 
     if let Some(el) = section("visualization") {
         visualization(ctx, el);
     }
-    if let Some(el) = section(super::faults::SECTION) {
-        super::faults::check_section(ctx, el);
-    }
+    let faults = section(super::faults::SECTION)
+        .map(|el| super::faults::read_section(ctx, el))
+        .unwrap_or_default();
     Some(Experiment {
         path: path.to_path_buf(),
         framework: framework?,
@@ -336,6 +341,7 @@ fn experiment(ctx: &mut Ctx, root: &Element, path: &Path) -> Option<Experiment> 
         arena: arena?,
         physics_engine: physics_engine?,
         media,
+        faults,
     })
 }
 
