@@ -4,7 +4,7 @@
 use proptest::prelude::*;
 use swarm_contract::config::Experiment;
 
-const THESIS: &str = include_str!("../../../configs/obstacle_avoidance/thesis_example.argos");
+const THESIS: &str = include_str!("../../../../configs/obstacle_avoidance/thesis_example.argos");
 
 /// One edit: delete `len` characters at a relative position, then insert `text` there.
 fn edit(source: &str, at: f64, len: usize, text: &str) -> String {

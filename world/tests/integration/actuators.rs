@@ -1,8 +1,6 @@
 //! Actuators and physics: differential drive, clamping, contacts, the virtual gripper and dead robots.
 
-mod common;
-
-use common::{TPS, builder, drive, frames, wall, wheels};
+use crate::common::{TPS, builder, drive, frames, wall, wheels};
 use swarm_contract::config::faults::DeadBodies;
 use swarm_contract::messages::{ActuatorCommand, GripperAction, Rgb};
 use swarm_world::arena::GripperEvent;

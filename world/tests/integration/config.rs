@@ -1,8 +1,6 @@
 //! Building worlds from configurations: the thesis example, `<distribute>` semantics and located errors.
 
-mod common;
-
-use common::config::{at, epuck, thesis_example, uniform};
+use crate::common::config::{at, epuck, thesis_example, uniform};
 use swarm_contract::config::{Element, Entity, LightEntity, LoopFunctions, PositionMethod, Vec3};
 use swarm_contract::messages::Rgb;
 use swarm_world::entities::ROBOT_RADIUS;

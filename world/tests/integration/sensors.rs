@@ -1,8 +1,6 @@
 //! Sensor models against analytic geometry, with the numbers of docs/epuck-and-world.md section 1.
 
-mod common;
-
-use common::{builder, frames, wall};
+use crate::common::{builder, frames, wall};
 use swarm_contract::messages::Rgb;
 use swarm_world::devices::{Devices, ProximityOptions};
 use swarm_world::entities::{FloorRegion, Light, ROBOT_RADIUS};

@@ -1,9 +1,7 @@
 //! Whole runs: determinism of the trajectory, the recorder's files and the obstacle-avoidance metrics.
 
-mod common;
-
-use common::config::thesis_example;
-use common::{builder, drive, wall, wheels};
+use crate::common::config::thesis_example;
+use crate::common::{builder, drive, wall, wheels};
 use swarm_contract::config::{Element, LoopFunctions};
 use swarm_world::devices::Devices;
 use swarm_world::geometry::Vec2;
@@ -59,7 +57,7 @@ fn recorder_writes_summary_metrics_and_png_snapshots_of_the_start_and_the_final_
         label: "obstacle_avoidance_loop_functions".into(),
         library: String::new(),
         params: Element::default(),
-        location: common::config::at(20),
+        location: crate::common::config::at(20),
     });
     let mut world = World::new(&exp, 7).expect("builds");
     let mut recorder = Recorder::create(dir.path(), &world, &[0]).expect("recorder");

@@ -14,7 +14,7 @@ mod generated {
     include!("algo_generated/worked_example.rs");
 }
 
-const GOLDEN: &str = "tests/algo_generated/worked_example.rs";
+const GOLDEN: &str = "tests/integration/algo_generated/worked_example.rs";
 
 /// The section 9 worked example with normalised probabilities.
 fn worked_example() -> SupervisorSet {
