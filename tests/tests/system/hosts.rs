@@ -183,6 +183,14 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
 #[test]
 fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     let (_, _, hosts) = single_and_two_hosts(&[]);
+    for (daemon, robot) in hosts.daemons.iter().zip([0, 5]) {
+        let log = daemon.agent_log(robot);
+        assert!(
+            log.contains("supervisors/fdc.ptsct"),
+            "an agent on host {} loads the run's compiled supervisors, not the models:\n{log}",
+            daemon.name
+        );
+    }
     hosts.stop_and_check_clean();
 }
 
