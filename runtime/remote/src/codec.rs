@@ -12,7 +12,7 @@
 use bincode::config::Configuration;
 use bincode::{Decode, Encode};
 
-use swarm_contract::messages::{ActuatorCommand, MESSAGE_VERSION};
+use swarm_contract::messages::MESSAGE_VERSION;
 
 /// First field of every message: `SWRM` read as a little-endian u32.
 pub const WIRE_MAGIC: u32 = u32::from_le_bytes(*b"SWRM");
@@ -67,20 +67,6 @@ impl Header {
             tick,
         }
     }
-}
-
-/// A host's answer for one robot in one tick.
-// Replies live in preallocated per-host slots and are decoded in place each tick; boxing the command would
-// allocate per robot per tick.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, Copy, PartialEq, Encode, Decode)]
-pub enum Reply {
-    /// The robot's agent answered with this command (its `robot` field is the run-wide robot id).
-    Answered(ActuatorCommand),
-    /// The agent did not answer before the host's deadline.
-    Missing,
-    /// The agent is dead (its process ended).
-    Dead,
 }
 
 /// Why a payload was rejected.
@@ -268,7 +254,8 @@ pub fn decode_message<T: Decode<()>>(bytes: &[u8], max_payload: usize) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use swarm_contract::messages::SensorFrame;
+    use crate::host_to_world::Reply;
+    use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
     fn frames(robots: &[u32], tick: u64) -> Vec<SensorFrame> {
         robots

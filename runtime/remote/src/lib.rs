@@ -1,9 +1,11 @@
-//! swarm-remote: the link across machines. The world speaks zenoh with one `swarm host` daemon per machine; robots always speak iceoryx2.
+//! swarm-remote: the link across machines. The world speaks zenoh with one `swarm host` daemon per machine;
+//! robots always speak iceoryx2.
 //!
-//! Each host daemon ([`host`]) announces itself with a zenoh liveliness token, receives its share of a run
-//! ([`assignment`]), runs it as a local lockstep run (its own iceoryx2 prefix and root, one agent process per
-//! robot) and bridges: per tick one message of its robots' frames in, one message of their replies out
-//! ([`codec`]); between ticks the world may send it fault orders for its robots' agents ([`orders`]). The
+//! Each host daemon ([`host`]) announces itself with a zenoh liveliness token, receives its share of a run,
+//! runs it as a local lockstep run (its own iceoryx2 prefix and root, one agent process per robot) and bridges:
+//! per tick one message of its robots' frames in, one message of their replies out; between ticks the world may
+//! send it fault orders for its robots' agents. The messages are in files named by direction
+//! ([`world_to_host`], [`host_to_world`]) and travel in the wire format of [`codec`]. The
 //! world's side ([`world_bridge`]) publishes one batch per host per tick, waits for each host's batch with the
 //! tick deadline, and treats the robots of a lost host as dead from the tick it notices the loss.
 //! Key expressions are in [`keys`], session settings in [`session`]. docs/hosts.md explains the choices.
@@ -14,14 +16,14 @@
 
 #![warn(missing_docs)]
 
-pub mod assignment;
 pub mod codec;
 pub mod host;
+pub mod host_to_world;
 pub mod keys;
-pub mod orders;
 pub mod plan;
 pub mod session;
 pub mod world_bridge;
+pub mod world_to_host;
 
 /// What can go wrong across hosts.
 #[derive(Debug, thiserror::Error)]

@@ -23,10 +23,10 @@ use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
 use zenoh::{Session, Wait};
 
-use super::assignment::{Assignment, AssignmentReply};
-use super::codec::{self, Header, Kind, Reply};
-use super::orders::{Order, OrderAction, OrderReply};
+use super::codec::{self, Header, Kind};
+use super::host_to_world::{AssignmentReply, OrderReply, Reply};
 use super::session::{ZenohOptions, zenoh_error};
+use super::world_to_host::{Assignment, Order, OrderAction};
 use super::{RemoteError, keys};
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::transport::{CommandStatus, TickOutcome};

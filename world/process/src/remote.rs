@@ -15,9 +15,9 @@ use swarm_contract::messages::{ActuatorCommand, SensorFrame, SupervisorSnapshot}
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::run_dir;
 use swarm_contract::transport::{CommandStatus, TickOutcome, WorldLink};
-use swarm_remote::orders::OrderAction;
 use swarm_remote::plan::HostsPlan;
 use swarm_remote::world_bridge::{HostEvent, RemoteHosts, RemoteOptions, RobotNews};
+use swarm_remote::world_to_host::OrderAction;
 
 /// Why the ticks stop waiting for a robot's agent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,0 +1,54 @@
+//! From a host daemon to the world: its answer to a share ([`AssignmentReply`]) and to a fault order
+//! ([`OrderReply`]) and, every tick, one batch of its robots' [`Reply`]s (a
+//! [`Kind::Replies`](crate::codec::Kind) batch, see [`crate::codec`]). What the world sends is in
+//! [`crate::world_to_host`].
+
+use bincode::{Decode, Encode};
+
+use swarm_contract::messages::ActuatorCommand;
+
+#[cfg(doc)]
+use crate::world_to_host::{Assignment, Order};
+
+/// A host's answer for one robot in one tick.
+// Replies live in preallocated per-host slots and are decoded in place each tick; boxing the command would
+// allocate per robot per tick.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq, Encode, Decode)]
+pub enum Reply {
+    /// The robot's agent answered with this command (its `robot` field is the run-wide robot id).
+    Answered(ActuatorCommand),
+    /// The agent did not answer before the host's deadline.
+    Missing,
+    /// The agent is dead (its process ended).
+    Dead,
+}
+
+/// The host's answer to an [`Assignment`].
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode)]
+pub enum AssignmentReply {
+    /// Every agent of the share joined; frames may come.
+    Ready {
+        /// Epoch of the assignment this answers.
+        epoch: u32,
+    },
+    /// The host cannot run the share, and why.
+    Refused {
+        /// Epoch of the assignment this answers.
+        epoch: u32,
+        /// What went wrong, for the user.
+        reason: String,
+    },
+}
+
+/// The host's answer to an [`Order`].
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode)]
+pub enum OrderReply {
+    /// Carried out.
+    Done,
+    /// Not carried out, and why (e.g. the agent to thaw is gone, a replacement failed to start).
+    Failed {
+        /// What went wrong, for the log.
+        reason: String,
+    },
+}
