@@ -1,14 +1,11 @@
 //! From a host daemon to the world: its answer to a share ([`AssignmentReply`]) and to a fault order
 //! ([`OrderReply`]) and, every tick, one batch of its robots' [`Reply`]s (a
 //! [`Kind::Replies`](crate::codec::Kind) batch, see [`crate::codec`]). What the world sends is in
-//! [`crate::world_to_host`].
+//! `world_to_host.rs`.
 
 use bincode::{Decode, Encode};
 
 use swarm_contract::messages::ActuatorCommand;
-
-#[cfg(doc)]
-use crate::world_to_host::{Assignment, Order};
 
 /// A host's answer for one robot in one tick.
 // Replies live in preallocated per-host slots and are decoded in place each tick; boxing the command would
@@ -24,7 +21,7 @@ pub enum Reply {
     Dead,
 }
 
-/// The host's answer to an [`Assignment`].
+/// The host's answer to an [`Assignment`](crate::world_to_host::Assignment).
 #[derive(Debug, Clone, PartialEq, Eq, Encode, Decode)]
 pub enum AssignmentReply {
     /// Every agent of the share joined; frames may come.
@@ -41,7 +38,7 @@ pub enum AssignmentReply {
     },
 }
 
-/// The host's answer to an [`Order`].
+/// The host's answer to an [`Order`](crate::world_to_host::Order).
 #[derive(Debug, Clone, PartialEq, Eq, Encode, Decode)]
 pub enum OrderReply {
     /// Carried out.

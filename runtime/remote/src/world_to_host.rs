@@ -1,6 +1,7 @@
 //! From the world to a host daemon: the host's share of a run ([`Assignment`]), fault orders for its robots'
-//! agents ([`Order`]) and, every tick, one batch of its robots' sensor frames (a [`Kind::Frames`] batch of
-//! [`SensorFrame`](swarm_contract::messages::SensorFrame)s, see [`crate::codec`]).
+//! agents ([`Order`]) and, every tick, one batch of its robots' sensor frames (a
+//! [`Kind::Frames`](crate::codec::Kind) batch of [`SensorFrame`](swarm_contract::messages::SensorFrame)s, see
+//! [`crate::codec`]).
 //!
 //! **The share** names the experiment by path (every host must see the same configuration and model files at the
 //! same path, e.g. one checkout or a shared file system), the run seed, the run-wide ids and controllers of the
@@ -22,9 +23,6 @@ use std::path::PathBuf;
 use bincode::{Decode, Encode};
 
 use swarm_contract::messages::SupervisorSnapshot;
-
-#[cfg(doc)]
-use crate::codec::Kind;
 
 /// What the world asks a host to run.
 #[derive(Debug, Clone, PartialEq, Encode, Decode)]

@@ -444,7 +444,11 @@ impl LiveRun {
         let mut rest = String::new();
         while self.stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
         let status = self.child.wait().expect("the launcher exits");
-        assert!(status.success(), "{rest}");
+        assert_eq!(
+            status.code(),
+            Some(130),
+            "an interrupted run exits 130:\n{rest}"
+        );
         assert_nothing_left(pid);
         assert!(
             !self.out.path().join("control.sock").exists(),

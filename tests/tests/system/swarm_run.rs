@@ -292,9 +292,10 @@ fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
     let mut rest = String::new();
     while stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
     let status = child.wait().expect("the launcher exits");
-    assert!(
-        status.success(),
-        "an interrupted run ends cleanly:\n{seen}{rest}"
+    assert_eq!(
+        status.code(),
+        Some(130),
+        "an interrupted run ends cleanly with the exit status of an interrupted program:\n{seen}{rest}"
     );
     let summary = summary(out.path());
     assert_eq!(summary["interrupted"], true);
@@ -319,4 +320,58 @@ fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
     );
     assert_eq!(process_leftovers(&prefix), Vec::<u32>::new());
     assert!(shm_leftovers(&prefix).is_empty());
+}
+
+/// A second run into a used `--out` is refused and loses nothing; `--overwrite` empties the folder first. The
+/// summary says what ran, by which program, when and from which configuration.
+#[test]
+fn a_used_run_folder_is_refused_unless_overwritten_and_the_summary_says_what_ran() {
+    let out = temp_dir();
+    let out_arg = out.path().display().to_string();
+    run_ok(OBSTACLE_AVOIDANCE, out.path(), &["--ticks", "5"]);
+    let first = summary(out.path());
+    assert_eq!(first["version"], env!("CARGO_PKG_VERSION"));
+    assert!(first["git_commit"].is_string() || first["git_commit"].is_null());
+    assert!(
+        first["started_at"]
+            .as_str()
+            .is_some_and(|t| t.ends_with('Z')),
+        "{}",
+        first["started_at"]
+    );
+    assert_eq!(
+        first["config"],
+        workspace_file(OBSTACLE_AVOIDANCE).display().to_string()
+    );
+    let command_line: Vec<&str> = first["command_line"]
+        .as_array()
+        .expect("the command line is recorded")
+        .iter()
+        .filter_map(serde_json::Value::as_str)
+        .collect();
+    assert_eq!(command_line[1..3], ["run", OBSTACLE_AVOIDANCE]);
+
+    let refused = swarm(&[
+        "run",
+        OBSTACLE_AVOIDANCE,
+        "--out",
+        &out_arg,
+        "--ticks",
+        "7",
+        "--no-progress",
+    ]);
+    assert!(!refused.output.status.success());
+    assert!(
+        refused.stderr().contains("pass --overwrite"),
+        "{}",
+        refused.stderr()
+    );
+    assert_eq!(summary(out.path()), first, "the refused run lost nothing");
+
+    run_ok(
+        OBSTACLE_AVOIDANCE,
+        out.path(),
+        &["--ticks", "7", "--overwrite"],
+    );
+    assert_eq!(summary(out.path())["ticks"], 7);
 }

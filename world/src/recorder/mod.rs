@@ -119,9 +119,11 @@ impl Recorder {
         }
         let path = self.dir.join(SUMMARY_FILE);
         let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
-        std::fs::write(&path, text).map_err(|source| WorldError::Io {
-            path: path.clone(),
-            source,
+        swarm_contract::run_dir::write_atomically(&path, text.as_bytes()).map_err(|source| {
+            WorldError::Io {
+                path: path.clone(),
+                source,
+            }
         })?;
         Ok(path)
     }

@@ -262,6 +262,7 @@ fn measured_run(
         ticks: Some(ticks),
         seed: Some(1),
         out: Some(out),
+        overwrite: true,
         progress: false,
         real_time,
         ..RunOptions::default()

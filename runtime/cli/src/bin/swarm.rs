@@ -55,9 +55,14 @@ enum Commands {
         /// Run seed (overrides the configuration's random_seed).
         #[arg(long)]
         seed: Option<u64>,
-        /// Run directory (default: runs/<config name>-<unix seconds>).
+        /// Run directory (default: a new runs/<config name>-<YYYYMMDD-HHMMSS>-<4 hex digits>). A folder that
+        /// holds an earlier run's files is refused unless --overwrite is given; one that another run is writing
+        /// into is always refused.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Empty --out first when it holds an earlier run's files.
+        #[arg(long, requires = "out")]
+        overwrite: bool,
         /// Milliseconds a tick waits for a missing command before it goes on without it (the same as
         /// --limit tick_deadline_ms=MS; default 500).
         #[arg(long = "tick-deadline-ms")]
@@ -213,10 +218,13 @@ struct HostCli {
     logs: Option<PathBuf>,
 }
 
+/// Exit status of a run stopped by Ctrl-C (or SIGTERM) with its records complete, as shells report SIGINT.
+const INTERRUPTED: u8 = 130;
+
 fn main() -> ExitCode {
     swarm_contract::logging::init("info");
     match run(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
@@ -259,26 +267,29 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
+/// Runs a subcommand; its exit status is 0, or 130 for a run stopped by Ctrl-C.
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    let done = |result: anyhow::Result<()>| result.map(|()| ExitCode::SUCCESS);
     match cli.command {
-        Commands::Bench(args) => bench(args),
+        Commands::Bench(args) => done(bench(args)),
         Commands::Experiment {
             grid,
             out,
             jobs,
             no_progress,
-        } => run_experiment(ExperimentOptions {
+        } => done(run_experiment(ExperimentOptions {
             grid,
             out,
             jobs,
             progress: !no_progress,
-        }),
+        })),
         Commands::Run {
             config,
             robots,
             ticks,
             seed,
             out,
+            overwrite,
             tick_deadline_ms,
             join_timeout_ms,
             mut limits,
@@ -297,6 +308,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 ticks,
                 seed,
                 out,
+                overwrite,
                 progress: !no_progress,
                 limits: {
                     let shorthands = [
@@ -338,10 +350,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 report.alive_final,
                 report.out_dir.display()
             );
-            Ok(())
+            Ok(if report.interrupted {
+                ExitCode::from(INTERRUPTED)
+            } else {
+                ExitCode::SUCCESS
+            })
         }
-        Commands::Ctl { run, request } => ctl(&run, request),
-        Commands::Host(cli) => run_host(cli),
+        Commands::Ctl { run, request } => done(ctl(&run, request)),
+        Commands::Host(cli) => done(run_host(cli)),
     }
 }
 

@@ -301,6 +301,7 @@ fn run_one(
         ticks: grid.ticks,
         seed: Some(seed),
         out: Some(partial.clone()),
+        overwrite: true,
         progress: false,
         ..RunOptions::default()
     };

@@ -49,7 +49,7 @@ use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs};
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::protocol::launcher_to_world::WorldCommand;
 use swarm_contract::protocol::world_to_launcher::WorldReport;
-use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE};
+use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE, RunDirError};
 use swarm_contract::transport::{self, RunSpec};
 use swarm_remote::plan::{HostsArgs, HostsError, HostsPlan};
 
@@ -69,8 +69,10 @@ pub struct RunOptions {
     pub ticks: Option<u64>,
     /// Run seed, overriding the configuration's `random_seed`.
     pub seed: Option<u64>,
-    /// Run directory (default `runs/<config name>-<unix seconds>`).
+    /// Run directory (default `runs/<config name>-<YYYYMMDD-HHMMSS>-<4 hex digits>`, new for every run).
     pub out: Option<PathBuf>,
+    /// Empty `out` first if it holds an earlier run's files (otherwise such a folder is refused).
+    pub overwrite: bool,
     /// Show a progress bar on the terminal.
     pub progress: bool,
     /// Limits overriding the configuration's, as `NAME=VALUE` (`swarm run --limit`; see
@@ -142,6 +144,9 @@ pub enum LaunchError {
     /// The hosts of the run cannot be resolved.
     #[error(transparent)]
     Hosts(#[from] HostsError),
+    /// The run directory cannot be used.
+    #[error(transparent)]
+    RunDir(#[from] RunDirError),
     /// A file or process operation failed.
     #[error("{what}: {source}")]
     Io {
@@ -232,8 +237,10 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .unwrap_or(0);
     let placement = HostsPlan::resolve(experiment.framework.hosts.as_ref(), &options.hosts)?
         .map(|plan| plan.place(robots));
-    let out_dir = run_dir::create(options.out.as_deref(), &options.config)
-        .map_err(io("creating the run directory"))?;
+    let started_at = SystemTime::now();
+    // Held (locked) until the run is over.
+    let run_folder = run_dir::create(options.out.as_deref(), options.overwrite, &options.config)?;
+    let out_dir = run_folder.path.clone();
     let binaries = Binaries::locate()?;
     let spec = RunSpec::unique();
     let _shared_memory = SharedMemoryGuard(spec.clone());
@@ -242,6 +249,11 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         iox_root: spec.root_dir().to_path_buf(),
     };
     let config = std::path::absolute(&options.config).map_err(io("resolving the config path"))?;
+    let provenance = Provenance {
+        command_line: std::env::args().collect(),
+        started_at,
+        config: config.clone(),
+    };
     let schedule = FaultSchedule::for_run(&experiment, &options.faults, robots)?;
     let ticks_per_second = experiment.framework.ticks_per_second;
     let mut startup = Vec::new();
@@ -375,14 +387,14 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
                 .map_err(io("cutting the records back to the last complete tick"))?;
             let report =
                 supervision.report(seed, robots, world_pid, agent_pids, complete.unwrap_or(0));
-            complete_summary(&out_dir, &report, Some(&error.to_string()))?;
+            complete_summary(&out_dir, &report, &provenance, Some(&error.to_string()))?;
         }
         return Err(error);
     }
     supervision.collect_agents();
     supervision.progress.finish_and_clear();
     let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
-    complete_summary(&out_dir, &report, None)?;
+    complete_summary(&out_dir, &report, &provenance, None)?;
     Ok(report)
 }
 
@@ -727,6 +739,7 @@ impl Supervision {
 fn complete_summary(
     out_dir: &Path,
     report: &RunReport,
+    provenance: &Provenance,
     world_died: Option<&str>,
 ) -> Result<(), LaunchError> {
     let path = out_dir.join(run_dir::SUMMARY_FILE);
@@ -764,7 +777,38 @@ fn complete_summary(
         if let Some(reason) = world_died {
             object.insert("world_died".into(), reason.into());
         }
+        object.extend(provenance.to_json());
     }
-    let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
-    std::fs::write(&path, text + "\n").map_err(io(format!("writing {}", path.display())))
+    let text = serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n";
+    run_dir::write_atomically(&path, text.as_bytes())
+        .map_err(io(format!("writing {}", path.display())))
+}
+
+/// Where a run came from: what was run, by which program, when, from which configuration.
+struct Provenance {
+    command_line: Vec<String>,
+    started_at: SystemTime,
+    config: PathBuf,
+}
+
+impl Provenance {
+    /// The fields `summary.json` gets: `command_line`, `version`, `git_commit` (null when the program was not
+    /// built from a git checkout), `started_at` (RFC 3339, UTC) and `config` (absolute path).
+    fn to_json(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut fields = serde_json::Map::new();
+        fields.insert("command_line".into(), self.command_line.clone().into());
+        fields.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+        fields.insert(
+            "git_commit".into(),
+            option_env!("SWARM_GIT_COMMIT").map_or(serde_json::Value::Null, Into::into),
+        );
+        fields.insert(
+            "started_at".into(),
+            humantime::format_rfc3339_seconds(self.started_at)
+                .to_string()
+                .into(),
+        );
+        fields.insert("config".into(), self.config.display().to_string().into());
+        fields
+    }
 }
