@@ -246,7 +246,10 @@ fn main() -> ExitCode {
     match run(&Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!(
+                "error: {}",
+                swarm_contract::logging::error_chain(err.as_ref())
+            );
             ExitCode::FAILURE
         }
     }

@@ -53,6 +53,16 @@ fn forty_robot_run_completes_with_one_process_per_robot() {
         "the run records the limits it used, with the command line's"
     );
     assert_eq!(summary["limits"]["tick_deadline_ms"], 500);
+    let agent_log =
+        std::fs::read_to_string(out.path().join("logs/robot-0.log")).expect("the agent's log");
+    assert!(
+        agent_log.contains("robot runs") && !agent_log.contains('\u{1b}'),
+        "a log file carries no colour codes:\n{agent_log}"
+    );
+    assert!(
+        !outcome.stderr().contains('\u{1b}'),
+        "nor does standard error off a terminal"
+    );
     let agents: Vec<u64> = summary["processes"]["agents"]
         .as_array()
         .expect("agent pids are listed")
@@ -191,6 +201,11 @@ fn assert_fails_before_first_tick(config: &str, out: &Path, expected: &[&str]) {
             "stderr should mention {needle:?}:\n{stderr}"
         );
     }
+    assert_eq!(
+        stderr.matches(expected[0]).count(),
+        1,
+        "the error is said once:\n{stderr}"
+    );
     assert!(!out.join("trajectory.csv").exists(), "no tick may run");
     assert_clean(&outcome);
 }
@@ -288,6 +303,10 @@ fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
         seen.contains("first tick completed"),
         "the run never ticked:\n{seen}"
     );
+    assert!(
+        seen.contains("it runs until Ctrl-C"),
+        "a run without a length says so at its start:\n{seen}"
+    );
     kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
     let mut rest = String::new();
     while stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
@@ -374,4 +393,17 @@ fn a_used_run_folder_is_refused_unless_overwritten_and_the_summary_says_what_ran
         &["--ticks", "7", "--overwrite"],
     );
     assert_eq!(summary(out.path())["ticks"], 7);
+}
+
+/// `--ticks` replaces the experiment's length both ways: longer than `length` as well as shorter.
+#[test]
+fn ticks_make_a_run_longer_than_the_experiments_length() {
+    let out = temp_dir();
+    // density_N10.argos: length 60 s at 20 ticks/s, 1,200 ticks.
+    run_ok(
+        "configs/obstacle_avoidance/density_N10.argos",
+        out.path(),
+        &["--ticks", "1210"],
+    );
+    assert_eq!(summary(out.path())["ticks"], 1210);
 }

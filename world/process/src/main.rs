@@ -57,7 +57,10 @@ fn main() -> ExitCode {
     match run(&cli.args, &cli.hosts) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("swarm-world: error: {e:#}");
+            eprintln!(
+                "swarm-world: error: {}",
+                swarm_contract::logging::error_chain(e.as_ref())
+            );
             ExitCode::FAILURE
         }
     }
@@ -82,6 +85,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         None => experiment,
     };
     let mut world = World::new(&experiment, args.seed)?;
+    // The launcher resolved the run's length (`--ticks`, else the experiment's `length`): it wins both ways.
+    world.set_max_ticks((args.ticks > 0).then_some(args.ticks));
     let robots = world.robot_count();
     let schedule = FaultSchedule::for_run(&experiment, &args.faults, robots as u32)?;
     world.set_dead_bodies(schedule.dead_bodies);
@@ -147,10 +152,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut commands_missing: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
-    while !stop.load(Ordering::Relaxed)
-        && !world.is_finished()
-        && (args.ticks == 0 || link.tick() < args.ticks)
-    {
+    while !stop.load(Ordering::Relaxed) && !world.is_finished() {
         faults.before_tick(
             link.tick() + 1,
             &mut link,

@@ -226,7 +226,10 @@ fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!(
+                "error: {}",
+                swarm_contract::logging::error_chain(e.as_ref())
+            );
             ExitCode::FAILURE
         }
     }

@@ -235,6 +235,12 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         .ticks
         .or(experiment.framework.max_ticks())
         .unwrap_or(0);
+    if ticks == 0 {
+        tracing::warn!(
+            "the run has no length (the experiment's length is 0 and no --ticks was given): it runs until \
+             Ctrl-C or until its loop functions end the experiment"
+        );
+    }
     let placement = HostsPlan::resolve(experiment.framework.hosts.as_ref(), &options.hosts)?
         .map(|plan| plan.place(robots));
     let started_at = SystemTime::now();

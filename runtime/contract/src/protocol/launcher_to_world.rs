@@ -27,7 +27,8 @@ pub struct WorldArgs {
     /// Run seed (already resolved: never 0-from-the-clock here).
     #[arg(long)]
     pub seed: u64,
-    /// Ticks to run; 0 runs until the loop functions finish the experiment or the launcher stops it.
+    /// Ticks to run, replacing the experiment's `length` either way; 0 runs until the loop functions finish the
+    /// experiment or the launcher stops it.
     #[arg(long, default_value_t = 0)]
     pub ticks: u64,
     /// Number of robots, overriding the configuration's e-puck `<distribute>` quantity.
