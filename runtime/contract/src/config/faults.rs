@@ -21,6 +21,7 @@ use super::diagnostic::{ConfigErrors, Diagnostic};
 use super::model::{Attribute, Element, Experiment, Location};
 use super::parse::Ctx;
 use super::values::Value;
+use crate::transport::MAX_ROBOTS;
 
 /// Name of the extension section.
 pub const SECTION: &str = "faults";
@@ -587,6 +588,12 @@ pub fn parse_robot_list(text: &str) -> Result<Vec<u32>, String> {
         if high < low {
             return Err(format!("the range '{part}' is empty"));
         }
+        // Checked before the range is expanded, so a huge range is an error, not gigabytes of indices.
+        if high >= MAX_ROBOTS {
+            return Err(format!(
+                "robot {high} is beyond the most robots a run can have ({MAX_ROBOTS})"
+            ));
+        }
         robots.extend(low..=high);
     }
     robots.sort_unstable();
@@ -749,6 +756,19 @@ mod tests {
         assert_eq!(parse_robot_list("4, 0,2-3").unwrap(), vec![0, 2, 3, 4]);
         assert!(parse_robot_list("5-2").is_err());
         assert!(parse_robot_list("a").is_err());
+    }
+
+    #[test]
+    fn a_huge_range_is_refused_before_it_is_expanded() {
+        let err = parse_robot_list("0-4294967295").expect_err("beyond any run");
+        assert!(
+            err.contains("beyond the most robots a run can have"),
+            "{err}"
+        );
+        let err = load("", &["kill robots=0-4294967295 tick=1"])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("--fault #1:1:"), "{err}");
     }
 
     #[test]

@@ -12,6 +12,7 @@
 pub mod diagnostic;
 pub mod faults;
 pub mod hosts;
+pub mod input;
 pub mod model;
 mod parse;
 mod registry;

@@ -3,6 +3,7 @@
 //! Every element and attribute gets the line and column where it starts, computed from quick-xml's byte offsets.
 //! Malformed XML becomes one located [`Diagnostic`]. This module knows nothing about the `.argos` vocabulary.
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -12,10 +13,20 @@ use quick_xml::events::{BytesStart, Event};
 use super::diagnostic::Diagnostic;
 use super::model::{Attribute, Element, Location};
 
+/// Deepest element nesting accepted: ARGoS files nest about six deep, and a limit keeps a hostile file from
+/// exhausting the stack of whatever walks the tree.
+pub const MAX_DEPTH: usize = 256;
+
 /// Maps byte offsets of one text to 1-based line and column (columns count characters, not bytes).
+///
+/// Offsets are asked for mostly in increasing order, so the last answer is kept: the next column on the same line
+/// is counted from there, and locating every element of a file costs time linear in its length even when the
+/// whole file is one line.
 pub(crate) struct LineIndex<'a> {
     text: &'a str,
     line_starts: Vec<usize>,
+    /// The last offset located: (offset, line index, 0-based column).
+    last: Cell<(usize, usize, usize)>,
 }
 
 impl<'a> LineIndex<'a> {
@@ -24,7 +35,11 @@ impl<'a> LineIndex<'a> {
         let line_starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
-        Self { text, line_starts }
+        Self {
+            text,
+            line_starts,
+            last: Cell::new((0, 0, 0)),
+        }
     }
 
     /// The location of a byte offset (clamped to the text).
@@ -32,10 +47,17 @@ impl<'a> LineIndex<'a> {
         let offset = offset.min(self.text.len());
         let line = self.line_starts.partition_point(|&start| start <= offset) - 1;
         let start = self.line_starts[line];
+        let (last_offset, last_line, last_column) = self.last.get();
+        let (from, base) = if last_line == line && (start..=offset).contains(&last_offset) {
+            (last_offset, last_column)
+        } else {
+            (start, 0)
+        };
         let column = self
             .text
-            .get(start..offset)
-            .map_or(offset - start, |prefix| prefix.chars().count());
+            .get(from..offset)
+            .map_or(offset - start, |part| base + part.chars().count());
+        self.last.set((offset, line, column));
         Location {
             line: to_u32(line + 1),
             column: to_u32(column + 1),
@@ -76,6 +98,13 @@ pub(crate) fn parse_tree(path: &Path, text: &str) -> Result<Element, Diagnostic>
             Event::Start(start) => {
                 let element =
                     open_element(&start, end, 2, text, &index).map_err(|(at, m)| error(at, m))?;
+                if stack.len() >= MAX_DEPTH {
+                    return Err(Diagnostic::new(
+                        path.to_path_buf(),
+                        element.location,
+                        format!("<{}> nests deeper than {MAX_DEPTH} elements", element.name),
+                    ));
+                }
                 stack.push(element);
             }
             Event::Empty(start) => {
@@ -184,7 +213,9 @@ fn open_element(
 
     let mut attributes = BTreeMap::new();
     let mut cursor = name.len();
-    for attribute in start.attributes() {
+    // quick-xml's own duplicate check compares each attribute with every earlier one (quadratic in their
+    // number); the map below finds duplicates in logarithmic time instead.
+    for attribute in start.attributes().with_checks(false) {
         let attribute = attribute.map_err(|e| {
             let at = match &e {
                 quick_xml::events::attributes::AttrError::ExpectedEq(p)
@@ -210,6 +241,16 @@ fn open_element(
         let (key_at, after) = find_attribute(raw, cursor, &key);
         cursor = after;
         let location = index.locate(content_start + key_at);
+        if let Some(first) = attributes.get(&key) {
+            let first: &Attribute = first;
+            return Err((
+                content_start + key_at,
+                format!(
+                    "attribute '{key}' appears twice in <{name}> (first at {})",
+                    first.location
+                ),
+            ));
+        }
         attributes.insert(key, Attribute { value, location });
     }
     Ok(Element {
@@ -262,6 +303,41 @@ mod tests {
         assert_eq!(
             index.locate(text.find('<').unwrap_or(0)),
             Location { line: 2, column: 3 }
+        );
+    }
+
+    #[test]
+    fn columns_are_the_same_in_any_order_of_questions() {
+        let text = "<a>\u{e9}<b/>\u{e9}\u{e9}<c/></a>\n<d>\u{e9}<e/></d>";
+        let fresh = |offset| LineIndex::new(text).locate(offset);
+        let index = LineIndex::new(text);
+        let offsets: Vec<usize> = text.char_indices().map(|(i, _)| i).collect();
+        for &offset in offsets.iter().chain(offsets.iter().rev()) {
+            assert_eq!(index.locate(offset), fresh(offset), "offset {offset}");
+        }
+    }
+
+    #[test]
+    fn nesting_deeper_than_the_limit_is_a_located_error_not_a_stack_overflow() {
+        let depth = 100_000;
+        let text = format!("{}{}", "<a>".repeat(depth), "</a>".repeat(depth));
+        let err = parse_tree(Path::new("deep.argos"), &text).expect_err("too deep");
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "deep.argos:1:{}: <a> nests deeper than {MAX_DEPTH} elements",
+                3 * MAX_DEPTH + 1
+            )
+        );
+    }
+
+    #[test]
+    fn a_duplicated_attribute_is_located_at_its_second_occurrence() {
+        let err = parse_tree(Path::new("f.argos"), "<a x=\"1\" y=\"2\" x=\"3\"/>")
+            .expect_err("duplicate");
+        assert_eq!(
+            err.to_string(),
+            "f.argos:1:16: attribute 'x' appears twice in <a> (first at 1:4)"
         );
     }
 

@@ -222,13 +222,8 @@ impl Ctx {
 
 /// Loads and checks an experiment configuration file.
 pub(crate) fn load(path: &Path) -> Result<(Experiment, Vec<Diagnostic>), ConfigErrors> {
-    let text = std::fs::read_to_string(path).map_err(|e| ConfigErrors {
-        errors: vec![Diagnostic::new(
-            path.to_path_buf(),
-            Location::default(),
-            format!("cannot read the file: {e}"),
-        )],
-    })?;
+    let text = super::input::read_text(path, super::input::MAX_CONFIG_BYTES)
+        .map_err(|d| ConfigErrors { errors: vec![d] })?;
     parse_str(path, &text)
 }
 
