@@ -478,3 +478,26 @@ pub fn wipe_runs(run_prefix: &str) {
     }
     remove_run_leftovers(run_prefix);
 }
+
+/// Waits until process `pid` (any process, not only a child) has ended, at most `limit`; whether it ended.
+/// Uses a pidfd, which becomes readable when the process exits, so nothing is polled.
+pub fn wait_gone(pid: u32, limit: std::time::Duration) -> bool {
+    // SAFETY: pidfd_open takes a pid and flags and returns a new descriptor or -1.
+    let fd = unsafe { libc::syscall(libc::SYS_pidfd_open, pid as libc::pid_t, 0) };
+    if fd < 0 {
+        // No such process (any more).
+        return true;
+    }
+    let fd = fd as libc::c_int;
+    let mut poll = libc::pollfd {
+        fd,
+        events: libc::POLLIN,
+        revents: 0,
+    };
+    let timeout = libc::c_int::try_from(limit.as_millis()).unwrap_or(libc::c_int::MAX);
+    // SAFETY: one valid pollfd for the duration of the call; the descriptor is ours and closed once.
+    let ready = unsafe { libc::poll(&mut poll, 1, timeout) };
+    // SAFETY: `fd` was returned by pidfd_open above and is not used after this.
+    unsafe { libc::close(fd) };
+    ready > 0
+}

@@ -400,6 +400,13 @@ impl Share {
             });
         }
         let run = assignment.run;
+        let removed = RunSpec::remove_dead_runs();
+        if removed > 0 {
+            tracing::info!(
+                removed,
+                "removed the shared memory of runs whose daemon was killed"
+            );
+        }
         let spec = RunSpec::unique();
         let mut link_config = LinkConfig::new(count.max(1));
         link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);

@@ -8,8 +8,8 @@ use std::process::{Command, Stdio};
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
-    SwarmOutcome, assert_clean, bin_dir, process_leftovers, shm_leftovers, swarm, workspace_file,
-    workspace_root,
+    SwarmOutcome, assert_clean, bin_dir, iceoryx_root_leftovers, process_leftovers, shm_leftovers,
+    swarm, wait_gone, workspace_file, workspace_root,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -406,4 +406,62 @@ fn ticks_make_a_run_longer_than_the_experiments_length() {
         &["--ticks", "1210"],
     );
     assert_eq!(summary(out.path())["ticks"], 1210);
+}
+
+/// A launcher killed with SIGKILL takes its world and its agents with it, and the next run removes the shared
+/// memory it could not remove itself.
+#[test]
+fn nothing_of_a_run_survives_its_killed_launcher() {
+    /// Removes what the killed run left even if an assertion below fails.
+    struct RemoveDeadRuns;
+    impl Drop for RemoveDeadRuns {
+        fn drop(&mut self) {
+            swarm_contract::transport::RunSpec::remove_dead_runs();
+        }
+    }
+    let _cleanup = RemoveDeadRuns;
+    let out = temp_dir();
+    let dir = bin_dir();
+    let mut child = Command::new(dir.join("swarm"))
+        .args([
+            "run",
+            "configs/obstacle_avoidance/thesis_example.argos",
+            "--no-progress",
+            "--out",
+        ])
+        .arg(out.path())
+        .env("SWARM_BIN_DIR", dir)
+        .env("RUST_LOG", "info")
+        .current_dir(workspace_root())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("swarm starts");
+    let pid = child.id();
+    let prefix = format!("sw{pid:x}-");
+    let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
+    let mut line = String::new();
+    while stderr.read_line(&mut line).expect("the launcher's log") > 0
+        && !line.contains("first tick completed")
+    {
+        line.clear();
+    }
+    let survivors = process_leftovers(&prefix);
+    assert!(survivors.len() > 1, "the world and the agents run");
+    kill(Pid::from_raw(pid as i32), Signal::SIGKILL).expect("kill the launcher");
+    child.wait().expect("the launcher is reaped");
+    for process in survivors {
+        assert!(
+            wait_gone(process, std::time::Duration::from_secs(30)),
+            "process {process} of the run outlived its launcher"
+        );
+    }
+    let next = temp_dir();
+    run_ok(OBSTACLE_AVOIDANCE, next.path(), &["--ticks", "1"]);
+    assert!(
+        shm_leftovers(&prefix).is_empty() && iceoryx_root_leftovers(&prefix).is_empty(),
+        "the next run removed the killed run's shared memory: {:?} {:?}",
+        shm_leftovers(&prefix),
+        iceoryx_root_leftovers(&prefix)
+    );
 }

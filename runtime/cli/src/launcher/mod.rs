@@ -248,6 +248,13 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let run_folder = run_dir::create(options.out.as_deref(), options.overwrite, &options.config)?;
     let out_dir = run_folder.path.clone();
     let binaries = Binaries::locate()?;
+    let removed = RunSpec::remove_dead_runs();
+    if removed > 0 {
+        tracing::info!(
+            removed,
+            "removed the shared memory of runs whose launcher was killed"
+        );
+    }
     let spec = RunSpec::unique();
     let _shared_memory = SharedMemoryGuard(spec.clone());
     let run_args = RunArgs {

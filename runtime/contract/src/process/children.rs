@@ -17,10 +17,19 @@ use nix::unistd::Pid;
 /// Starts `command` as a supervised child: own process group, killed with the launcher.
 pub fn spawn(command: &mut Command) -> std::io::Result<Child> {
     command.process_group(0);
-    // SAFETY: the closure runs between fork and exec and only makes the async-signal-safe prctl system call.
+    let parent = nix::unistd::getpid();
+    // SAFETY: the closure runs between fork and exec and only makes async-signal-safe system calls (prctl,
+    // getppid).
     unsafe {
-        command.pre_exec(|| {
-            nix::sys::prctl::set_pdeathsig(Signal::SIGKILL).map_err(std::io::Error::from)
+        command.pre_exec(move || {
+            nix::sys::prctl::set_pdeathsig(Signal::SIGKILL).map_err(std::io::Error::from)?;
+            // A parent that died between fork and prctl sends no signal any more: the child must not start.
+            if nix::unistd::getppid() != parent {
+                return Err(std::io::Error::other(
+                    "the launcher died while starting this process",
+                ));
+            }
+            Ok(())
         });
     }
     command.spawn()

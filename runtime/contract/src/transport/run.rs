@@ -142,6 +142,46 @@ impl RunSpec {
         Ok(removed)
     }
 
+    /// Removes the files of every run on this host whose launcher (or host daemon) is gone: a run named by
+    /// [`RunSpec::unique`] carries its creator's process id, and a run whose creator no longer exists was killed
+    /// before it could clean up (SIGKILL, power loss). Runs of a living process are left alone, whatever that
+    /// process is, so a reused process id can only keep files, never remove a live run's. Returns the number of
+    /// entries removed.
+    pub fn remove_dead_runs() -> usize {
+        let mut dead: Vec<String> = std::fs::read_dir(SHM_DIR)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter_map(|entry| {
+                let file = entry.file_name().to_string_lossy().into_owned();
+                let name = match file.strip_prefix("iox2_") {
+                    Some(rest) => rest.split('_').next()?.to_owned(),
+                    None => file.strip_prefix("iceoryx2-")?.to_owned(),
+                };
+                let creator = name.strip_prefix("sw")?.split('-').next()?;
+                let pid = u32::from_str_radix(creator, 16).ok()?;
+                let alive = Path::new("/proc").join(pid.to_string()).exists();
+                (!alive).then_some(name)
+            })
+            .collect();
+        dead.sort_unstable();
+        dead.dedup();
+        let mut removed = 0;
+        for name in dead {
+            let Ok(run) = RunSpec::new(
+                &name,
+                Path::new(RUN_ROOTS_DIR).join(format!("iceoryx2-{name}")),
+            ) else {
+                continue;
+            };
+            match run.cleanup() {
+                Ok(n) => removed += n,
+                Err(e) => tracing::warn!("removing the files of the dead run {name}: {e}"),
+            }
+        }
+        removed
+    }
+
     /// Paths of every file of this run still present (empty after [`RunSpec::cleanup`]).
     pub fn leftovers(&self) -> Vec<PathBuf> {
         let prefix = self.shm_prefix();
