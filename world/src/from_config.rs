@@ -27,6 +27,10 @@ pub fn locate(exp: &Experiment, location: Location) -> String {
     format!("{}:{}", exp.path.display(), location)
 }
 
+/// Most cells of a pheromone grid (per channel): every channel holds two `f32` grids, so this bounds the field
+/// at 4 x 2 x 4 x 4 Mi bytes = 128 MiB.
+pub const MAX_PHEROMONE_CELLS: u64 = 4 * 1024 * 1024;
+
 fn invalid(exp: &Experiment, location: Location, message: impl Into<String>) -> WorldError {
     WorldError::Invalid {
         location: locate(exp, location),
@@ -208,6 +212,19 @@ pub fn build(
                 evaporation: ch.evaporation as f32,
                 diffusion: ch.diffusion as f32,
             };
+        }
+        let size = exp.arena.size;
+        let cells = (size.x / p.cell_size).ceil() * (size.y / p.cell_size).ceil();
+        if cells > MAX_PHEROMONE_CELLS as f64 {
+            return Err(invalid(
+                exp,
+                p.location,
+                format!(
+                    "the pheromone grid would have {cells:.0} cells of {} m over the arena; at most \
+                     {MAX_PHEROMONE_CELLS}: use a larger cell_size",
+                    p.cell_size
+                ),
+            ));
         }
         b.pheromone(p.cell_size as f32, rates);
     }

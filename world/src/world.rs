@@ -49,10 +49,6 @@ impl WorldBuilder {
     /// An empty arena `min..max` stepping `ticks_per_second` times per simulated second, for the run `seed`.
     pub fn new(min: Vec2, max: Vec2, ticks_per_second: u32, seed: u64) -> Self {
         let ticks_per_second = ticks_per_second.max(1);
-        let no_decay = [ChannelRates {
-            evaporation: 0.0,
-            diffusion: 0.0,
-        }; PHEROMONE_CHANNELS];
         Self {
             arena: Arena {
                 robots: Vec::new(),
@@ -60,7 +56,8 @@ impl WorldBuilder {
                 targets: Vec::new(),
                 lights: Vec::new(),
                 floor: Vec::new(),
-                pheromone: PheromoneField::new(min, max, DEFAULT_PHEROMONE_CELL, no_decay),
+                // Memory for pheromone only when a pheromone medium asks for it (`WorldBuilder::pheromone`).
+                pheromone: PheromoneField::off(min),
                 min,
                 max,
                 tick: 0,

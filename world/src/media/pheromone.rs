@@ -27,6 +27,8 @@ pub struct PheromoneField {
     touched: [bool; PHEROMONE_CHANNELS],
     values: Vec<f32>,
     scratch: Vec<f32>,
+    /// False for the field of a run without a pheromone medium: deposits are ignored and every reading is 0.
+    active: bool,
 }
 
 impl PheromoneField {
@@ -45,6 +47,20 @@ impl PheromoneField {
             touched: [false; PHEROMONE_CHANNELS],
             values: vec![0.0; n],
             scratch: vec![0.0; n],
+            active: true,
+        }
+    }
+
+    /// A field of one cell that nothing deposits into: the arena of a run without a pheromone medium, which then
+    /// costs no memory whatever its size.
+    pub fn off(origin: Vec2) -> Self {
+        let no_decay = [ChannelRates {
+            evaporation: 0.0,
+            diffusion: 0.0,
+        }; PHEROMONE_CHANNELS];
+        Self {
+            active: false,
+            ..Self::new(origin, origin, 1.0, no_decay)
         }
     }
 
@@ -76,7 +92,7 @@ impl PheromoneField {
 
     /// Adds `amount` to the cell under `p` (negative amounts erase, never below zero).
     pub fn deposit(&mut self, channel: usize, p: Vec2, amount: f32) {
-        if channel >= PHEROMONE_CHANNELS || amount == 0.0 || !amount.is_finite() {
+        if !self.active || channel >= PHEROMONE_CHANNELS || amount == 0.0 || !amount.is_finite() {
             return;
         }
         let (x, y) = self.cell_of(p);

@@ -211,3 +211,25 @@ fn controller_devices_and_noise_come_from_the_configuration() {
     );
     assert_eq!(d.camera, None);
 }
+
+#[test]
+fn a_pheromone_grid_too_large_for_memory_is_a_located_error_and_no_grid_without_pheromones() {
+    let mut exp = thesis_example();
+    exp.arena.size = Vec3::new(9000.0, 9000.0, 1.0);
+    let world = World::new(&exp, 1).expect("a huge arena without pheromones costs no grid");
+    assert_eq!(world.arena.pheromone.dimensions().0, 1);
+    exp.media.pheromone = Some(swarm_contract::config::PheromoneField {
+        id: "pheromones".into(),
+        cell_size: 0.05,
+        channels: Vec::new(),
+        location: at(30),
+    });
+    let err = World::new(&exp, 1).err().expect("a grid of 3.2e10 cells");
+    let text = err.to_string();
+    assert!(
+        text.starts_with(
+            "configs/obstacle_avoidance/thesis_example.argos:30:5: the pheromone grid would have"
+        ),
+        "{text}"
+    );
+}

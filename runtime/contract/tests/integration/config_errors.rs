@@ -1083,3 +1083,16 @@ fn limits_in_system_override_the_defaults_and_a_misspelt_one_is_named() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn an_arena_larger_than_the_physics_can_place_precisely_is_refused() {
+    for size in ["1e15,3,1", "3,1e38,1", "10000.5,3,1"] {
+        let text = config(&[(r#"size="3,3,1""#, &format!(r#"size="{size}""#))]);
+        let errors = errors(&text);
+        assert_eq!(errors.len(), 1, "{size}: {errors:?}");
+        assert!(
+            errors[0].contains("arena 'size' must be positive and at most 10000 m in x and y"),
+            "{size}: {errors:?}"
+        );
+    }
+}

@@ -39,6 +39,10 @@ const TARGET_LED_HEIGHT: f64 = 0.06;
 /// Default floor resolution when `pixels_per_meter` is absent.
 const PIXELS_PER_METER: f64 = 50.0;
 
+/// Longest arena side accepted, in metres: far beyond any swarm experiment, and small enough that positions keep
+/// millimetre precision in the physics engine's 32-bit floats.
+pub const MAX_ARENA_SIDE: f64 = 10_000.0;
+
 /// Parses `<arena size center>`.
 pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
     ctx.unknown_attributes(el, &["size", "center", "positional_grid_size"]);
@@ -50,8 +54,9 @@ pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
         );
     }
     let size: Option<Vec3> = ctx.required(el, "size");
+    let side_ok = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ARENA_SIDE;
     if let Some(s) = size
-        && (s.x <= 0.0 || s.y <= 0.0)
+        && !(side_ok(s.x) && side_ok(s.y))
     {
         let at = el
             .attributes
@@ -59,7 +64,9 @@ pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
             .map_or(el.location, |a| a.location);
         ctx.error(
             at,
-            format!("arena 'size' must be positive in x and y, got {s}"),
+            format!(
+                "arena 'size' must be positive and at most {MAX_ARENA_SIDE} m in x and y, got {s}"
+            ),
             None,
         );
     }
