@@ -99,6 +99,15 @@ pub fn build(
     }
     let control =
         control::build(&plan, &params, run_seed, robot).map_err(|e| located(e.to_string()))?;
+    for (name, hint) in params.unread() {
+        let hint = hint.map_or_else(String::new, |h| format!(" ({h})"));
+        tracing::warn!(
+            "{}",
+            located(format!(
+                "parameter '{name}' is not used by this controller and is ignored{hint}"
+            ))
+        );
+    }
     Ok((plan, control))
 }
 

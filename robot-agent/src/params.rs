@@ -4,6 +4,9 @@
 //! nothing here runs per tick. Errors name the parameter and the offending value; the caller adds the file and
 //! line of the `<params>` element.
 
+use std::collections::BTreeSet;
+use std::sync::{Arc, Mutex, PoisonError};
+
 use thiserror::Error;
 
 /// A bad controller parameter.
@@ -32,11 +35,24 @@ pub enum ParamError {
 }
 
 /// The attributes of a `<params>` element, in document order, and the run's seed.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+///
+/// Every name a controller asks for is remembered (by every clone alike), so that after the controller is built
+/// the parameters nobody asked for ([`Params::unread`]) can be reported: a misspelt attribute is otherwise
+/// silently ignored.
+#[derive(Debug, Clone, Default)]
 pub struct Params {
     entries: Vec<(String, String)>,
     run_seed: u64,
+    asked: Arc<Mutex<BTreeSet<String>>>,
 }
+
+impl PartialEq for Params {
+    fn eq(&self, other: &Self) -> bool {
+        self.entries == other.entries && self.run_seed == other.run_seed
+    }
+}
+
+impl Eq for Params {}
 
 impl Params {
     /// Parameters from name/value pairs (later duplicates win, as in an XML attribute map).
@@ -52,6 +68,7 @@ impl Params {
                 .map(|(k, v)| (k.into(), v.into()))
                 .collect(),
             run_seed: 0,
+            asked: Arc::default(),
         }
     }
 
@@ -68,11 +85,35 @@ impl Params {
 
     /// The raw value of `name`, if given.
     pub fn get(&self, name: &str) -> Option<&str> {
+        let mut asked = self.asked.lock().unwrap_or_else(PoisonError::into_inner);
+        if !asked.contains(name) {
+            asked.insert(name.to_owned());
+        }
+        drop(asked);
         self.entries
             .iter()
             .rev()
             .find(|(k, _)| k == name)
             .map(|(_, v)| v.as_str())
+    }
+
+    /// The parameters given but never asked for, each with the closest name that was asked for (a likely
+    /// typo), in document order.
+    pub fn unread(&self) -> Vec<(&str, Option<String>)> {
+        let asked = self.asked.lock().unwrap_or_else(PoisonError::into_inner);
+        let mut seen = BTreeSet::new();
+        self.entries
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .filter(|name| !asked.contains(*name) && seen.insert(*name))
+            .map(|name| {
+                let hint = swarm_contract::config::suggest::did_you_mean(
+                    name,
+                    asked.iter().map(String::as_str),
+                );
+                (name, hint)
+            })
+            .collect()
     }
 
     /// `name` as a finite `f32`, or `default` when absent.

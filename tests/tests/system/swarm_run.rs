@@ -465,3 +465,37 @@ fn nothing_of_a_run_survives_its_killed_launcher() {
         iceoryx_root_leftovers(&prefix)
     );
 }
+
+/// A misspelt controller parameter is not silently ignored: the run names it, where it is, and the likely meant
+/// one.
+#[test]
+fn a_misspelt_controller_parameter_is_warned_with_a_suggestion() {
+    let dir = temp_dir();
+    let text =
+        std::fs::read_to_string(workspace_file(OBSTACLE_AVOIDANCE)).expect("the main experiment");
+    assert!(
+        text.contains("<params "),
+        "the experiment has controller parameters"
+    );
+    // The models by absolute path, so the copy runs from the temporary folder.
+    let models = workspace_file("configs/obstacle_avoidance/models/ptsct");
+    let text = text
+        .replacen("<params ", "<params velocty=\"5\" ", 1)
+        .replace(
+            "supervisors=\"models/ptsct\"",
+            &format!("supervisors=\"{}\"", models.display()),
+        );
+    let path = dir.path().join("misspelt_params.argos");
+    std::fs::write(&path, text).expect("write the experiment");
+    let outcome = run_ok(
+        &path.display().to_string(),
+        &dir.path().join("out"),
+        &["--ticks", "1"],
+    );
+    let stderr = outcome.stderr();
+    assert!(
+        stderr.contains("parameter 'velocty' is not used by this controller and is ignored (did you mean 'velocity'?)")
+            && stderr.contains("misspelt_params.argos:"),
+        "{stderr}"
+    );
+}

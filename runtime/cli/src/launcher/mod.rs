@@ -456,6 +456,14 @@ fn check_controllers(
                 log: lines[lines.len().saturating_sub(LOG_LINES_QUOTED)..].join("\n"),
             });
         }
+        // The check's warnings (e.g. a parameter no callback reads) would otherwise be seen by nobody.
+        for warning in String::from_utf8_lossy(&output.stderr)
+            .lines()
+            .filter_map(|line| line.split_once(" WARN "))
+            .map(|(_, rest)| rest.split_once(": ").map_or(rest, |(_, message)| message))
+        {
+            tracing::warn!("{warning}");
+        }
         let names: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap_or_default();
         tables.insert(controller.clone(), names);
         // Native controllers have no supervisors: no file, and their agents get no flag.

@@ -17,7 +17,7 @@ pub mod model;
 mod parse;
 mod registry;
 mod robot_count;
-mod suggest;
+pub mod suggest;
 mod values;
 mod xml;
 

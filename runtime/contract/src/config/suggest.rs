@@ -30,10 +30,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 
 /// The known name closest to `wrong`, if any is close enough to be a plausible typo: a name that starts with
 /// `wrong` (an abbreviation such as `epuck_prox`), or one within an edit distance of a third of its length.
-pub(crate) fn closest<'a>(
-    wrong: &str,
-    known: impl IntoIterator<Item = &'a str>,
-) -> Option<&'a str> {
+pub fn closest<'a>(wrong: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let known: Vec<&str> = known.into_iter().collect();
     if wrong.chars().count() >= 3
         && let Some(prefixed) = known
@@ -52,10 +49,7 @@ pub(crate) fn closest<'a>(
 }
 
 /// A hint `did you mean 'x'?` for `wrong`, if a close name exists.
-pub(crate) fn did_you_mean<'a>(
-    wrong: &str,
-    known: impl IntoIterator<Item = &'a str>,
-) -> Option<String> {
+pub fn did_you_mean<'a>(wrong: &str, known: impl IntoIterator<Item = &'a str>) -> Option<String> {
     closest(wrong, known).map(|k| format!("did you mean '{k}'?"))
 }
 
