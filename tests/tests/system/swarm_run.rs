@@ -499,3 +499,49 @@ fn a_misspelt_controller_parameter_is_warned_with_a_suggestion() {
         "{stderr}"
     );
 }
+
+/// A run that needs more open files than the machine allows is refused before it starts, with what to do, not
+/// with a transport error from deep inside the world.
+#[test]
+fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
+    use std::os::unix::process::CommandExt;
+    let out = temp_dir();
+    let dir = bin_dir();
+    let mut command = Command::new(dir.join("swarm"));
+    command
+        .args([
+            "run",
+            "configs/obstacle_avoidance/density_N100.argos",
+            "--ticks",
+            "1",
+            "--no-progress",
+            "--out",
+        ])
+        .arg(out.path())
+        .env("SWARM_BIN_DIR", dir)
+        .current_dir(workspace_root());
+    // SAFETY: between fork and exec the closure only makes the async-signal-safe setrlimit call.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: 300,
+                rlim_max: 300,
+            };
+            if libc::setrlimit(libc::RLIMIT_NOFILE, &limit) == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        });
+    }
+    let output = command.output().expect("swarm runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains(
+            "100 robots need about 728 open files, but this process may open at most 300"
+        ),
+        "{stderr}"
+    );
+    assert!(!out.path().join("summary.json").exists(), "nothing started");
+}

@@ -88,6 +88,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     // The launcher resolved the run's length (`--ticks`, else the experiment's `length`): it wins both ways.
     world.set_max_ticks((args.ticks > 0).then_some(args.ticks));
     let robots = world.robot_count();
+    swarm_contract::process::open_files::ensure(robots as u32)?;
     let schedule = FaultSchedule::for_run(&experiment, &args.faults, robots as u32)?;
     world.set_dead_bodies(schedule.dead_bodies);
     let roster: Vec<(String, String)> = experiment
