@@ -264,41 +264,67 @@ fn invalid_configuration_is_reported_with_its_location() {
     );
 }
 
+/// The thesis example (no length) started as a user would, its log read until its first tick.
+struct LiveRun {
+    child: std::process::Child,
+    pid: u32,
+    stderr: BufReader<std::process::ChildStderr>,
+    /// The launcher's log up to the first tick.
+    seen: String,
+}
+
+impl LiveRun {
+    fn start(out: &Path) -> LiveRun {
+        let dir = bin_dir();
+        let mut child = Command::new(dir.join("swarm"))
+            .args([
+                "run",
+                "configs/obstacle_avoidance/thesis_example.argos",
+                "--no-progress",
+                "--out",
+            ])
+            .arg(out)
+            .env("SWARM_BIN_DIR", dir)
+            .env("RUST_LOG", "info")
+            .current_dir(workspace_root())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("swarm starts");
+        let pid = child.id();
+        let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
+        let mut seen = String::new();
+        let mut line = String::new();
+        while stderr
+            .read_line(&mut line)
+            .expect("read the launcher's log")
+            > 0
+        {
+            seen.push_str(&line);
+            if line.contains("first tick completed") {
+                break;
+            }
+            line.clear();
+        }
+        LiveRun {
+            child,
+            pid,
+            stderr,
+            seen,
+        }
+    }
+}
+
 #[test]
 fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
     let out = temp_dir();
-    let dir = bin_dir();
-    let mut child = Command::new(dir.join("swarm"))
-        .args([
-            "run",
-            "configs/obstacle_avoidance/thesis_example.argos",
-            "--no-progress",
-            "--out",
-        ])
-        .arg(out.path())
-        .env("SWARM_BIN_DIR", dir)
-        .env("RUST_LOG", "info")
-        .current_dir(workspace_root())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("swarm starts");
-    let pid = child.id();
+    let LiveRun {
+        mut child,
+        pid,
+        mut stderr,
+        seen,
+    } = LiveRun::start(out.path());
     let prefix = format!("sw{pid:x}-");
-    let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
-    let mut seen = String::new();
-    let mut line = String::new();
-    while stderr
-        .read_line(&mut line)
-        .expect("read the launcher's log")
-        > 0
-    {
-        seen.push_str(&line);
-        if line.contains("first tick completed") {
-            break;
-        }
-        line.clear();
-    }
     assert!(
         seen.contains("first tick completed"),
         "the run never ticked:\n{seen}"
@@ -421,33 +447,19 @@ fn nothing_of_a_run_survives_its_killed_launcher() {
     }
     let _cleanup = RemoveDeadRuns;
     let out = temp_dir();
-    let dir = bin_dir();
-    let mut child = Command::new(dir.join("swarm"))
-        .args([
-            "run",
-            "configs/obstacle_avoidance/thesis_example.argos",
-            "--no-progress",
-            "--out",
-        ])
-        .arg(out.path())
-        .env("SWARM_BIN_DIR", dir)
-        .env("RUST_LOG", "info")
-        .current_dir(workspace_root())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("swarm starts");
-    let pid = child.id();
+    // The log pipe stays open until the end: a launcher must not be disturbed by a closed standard error.
+    let LiveRun {
+        mut child,
+        pid,
+        stderr: _stderr,
+        seen,
+    } = LiveRun::start(out.path());
     let prefix = format!("sw{pid:x}-");
-    let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
-    let mut line = String::new();
-    while stderr.read_line(&mut line).expect("the launcher's log") > 0
-        && !line.contains("first tick completed")
-    {
-        line.clear();
-    }
     let survivors = process_leftovers(&prefix);
-    assert!(survivors.len() > 1, "the world and the agents run");
+    assert!(
+        survivors.len() > 1,
+        "the world and the agents run: {survivors:?}\n{seen}"
+    );
     kill(Pid::from_raw(pid as i32), Signal::SIGKILL).expect("kill the launcher");
     child.wait().expect("the launcher is reaped");
     for process in survivors {

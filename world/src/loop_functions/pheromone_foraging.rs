@@ -158,13 +158,10 @@ mod tests {
             0,
             DEFAULT_SOURCE_RADIUS,
         )));
-        let still = crate::media::pheromone::ChannelRates {
-            evaporation: 0.0,
-            diffusion: 0.0,
-        };
         b.pheromone(
             crate::world::DEFAULT_PHEROMONE_CELL,
-            [still; swarm_contract::messages::PHEROMONE_CHANNELS],
+            [crate::media::pheromone::ChannelRates::STILL;
+                swarm_contract::messages::PHEROMONE_CHANNELS],
         );
         let mut w = b.build();
         w.arena.pheromone.deposit(0, Vec2::new(0.1, 0.1), 1.0);

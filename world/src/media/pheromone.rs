@@ -15,6 +15,14 @@ pub struct ChannelRates {
     pub diffusion: f32,
 }
 
+impl ChannelRates {
+    /// Neither evaporation nor diffusion: what is deposited stays.
+    pub const STILL: ChannelRates = ChannelRates {
+        evaporation: 0.0,
+        diffusion: 0.0,
+    };
+}
+
 /// The field of every channel.
 #[derive(Debug, Clone)]
 pub struct PheromoneField {
@@ -54,13 +62,14 @@ impl PheromoneField {
     /// A field of one cell that nothing deposits into: the arena of a run without a pheromone medium, which then
     /// costs no memory whatever its size.
     pub fn off(origin: Vec2) -> Self {
-        let no_decay = [ChannelRates {
-            evaporation: 0.0,
-            diffusion: 0.0,
-        }; PHEROMONE_CHANNELS];
         Self {
             active: false,
-            ..Self::new(origin, origin, 1.0, no_decay)
+            ..Self::new(
+                origin,
+                origin,
+                1.0,
+                [ChannelRates::STILL; PHEROMONE_CHANNELS],
+            )
         }
     }
 

@@ -361,13 +361,10 @@ fn pheromone_deposit_is_sensed_with_its_gradient_in_the_robot_frame() {
         std::f32::consts::FRAC_PI_2,
         Devices::ALL,
     );
-    let still = swarm_world::media::pheromone::ChannelRates {
-        evaporation: 0.0,
-        diffusion: 0.0,
-    };
     b.pheromone(
         swarm_world::world::DEFAULT_PHEROMONE_CELL,
-        [still; swarm_contract::messages::PHEROMONE_CHANNELS],
+        [swarm_world::media::pheromone::ChannelRates::STILL;
+            swarm_contract::messages::PHEROMONE_CHANNELS],
     );
     let mut world = b.build();
     let mut cmd = swarm_contract::messages::ActuatorCommand::idle(0, 1);
