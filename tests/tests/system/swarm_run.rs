@@ -557,3 +557,20 @@ fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
     );
     assert!(!out.path().join("summary.json").exists(), "nothing started");
 }
+
+/// Off a terminal the progress bar cannot be drawn: the run logs plain progress lines instead, at a low rate.
+#[test]
+fn a_run_off_a_terminal_logs_its_progress_as_lines() {
+    let out = temp_dir();
+    let out_arg = out.path().display().to_string();
+    let outcome = swarm(&["run", OBSTACLE_AVOIDANCE, "--out", &out_arg, "--ticks", "5"]);
+    assert!(outcome.output.status.success(), "{}", outcome.stderr());
+    assert!(
+        outcome
+            .stderr()
+            .contains("tick 1/5 (20%), 40/40 robots alive"),
+        "{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+}

@@ -19,11 +19,12 @@ mod agents;
 pub mod control;
 mod fault_handling;
 pub mod fault_log;
+mod plain_progress;
 pub mod records;
 pub mod restart;
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::{ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::Arc;
@@ -37,6 +38,7 @@ use nix::sys::signal::Signal;
 use agents::{AgentSpawner, RobotEntry};
 use control::ControlServer;
 use fault_log::FaultRecord;
+use plain_progress::PlainProgress;
 use restart::RestartTracker;
 use swarm_contract::config::faults::{FaultKind, FaultSchedule};
 use swarm_contract::config::{ConfigErrors, Experiment};
@@ -379,6 +381,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         pending_restarts: Vec::new(),
         reaped: Vec::new(),
         agent_exit_grace: limits.agent_exit_grace(),
+        plain_progress: (options.progress && !std::io::stderr().is_terminal())
+            .then(|| PlainProgress::new(ticks, robots)),
         host_names: placement
             .iter()
             .flatten()
@@ -592,6 +596,8 @@ struct Supervision {
     control: Option<ControlServer>,
     /// How long agents get to exit by themselves after the run.
     agent_exit_grace: Duration,
+    /// Progress as log lines when standard error is not a terminal (the bar is drawn only on one).
+    plain_progress: Option<PlainProgress>,
 }
 
 impl Supervision {
@@ -622,6 +628,11 @@ impl Supervision {
                     self.last_tick = tick;
                     self.progress.set_position(tick);
                     let total = self.roster_ids.len() as u32;
+                    if let Some(plain) = &mut self.plain_progress
+                        && let Some(line) = plain.update(tick, total.saturating_sub(dead))
+                    {
+                        tracing::info!("{line}");
+                    }
                     self.progress.set_message(format!(
                         "{}/{total} robots alive",
                         total.saturating_sub(dead)
