@@ -45,7 +45,7 @@ pub fn load(inputs: &[Input], options: ValidateOptions) -> Result<Validation, Lo
     let mut sources = Vec::new();
     for input in inputs {
         let name = display(&input.path);
-        let bytes = std::fs::read(&input.path).map_err(|source| LoadError {
+        let bytes = read_limited(&input.path).map_err(|source| LoadError {
             path: name.clone(),
             source,
         })?;
@@ -68,6 +68,39 @@ pub fn load(inputs: &[Input], options: ValidateOptions) -> Result<Validation, Lo
         validation.models = None;
     }
     Ok(validation)
+}
+
+/// Largest model file read: far above any hand-written model, and a bound on the memory a wrong path (a device
+/// such as `/dev/zero`) can take.
+pub const MAX_MODEL_BYTES: u64 = 512 * 1024 * 1024;
+
+/// The bytes of a regular file of at most [`MAX_MODEL_BYTES`]; a FIFO, a device or a folder is refused before it
+/// is read (a FIFO would block forever).
+fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let refuse = |message: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, message);
+    let metadata = std::fs::metadata(path)?;
+    if !metadata.is_file() {
+        return Err(refuse(
+            "not a regular file (a device, FIFO or folder cannot be a model)".into(),
+        ));
+    }
+    if metadata.len() > MAX_MODEL_BYTES {
+        return Err(refuse(format!(
+            "{} bytes, more than the {MAX_MODEL_BYTES} a model file may have",
+            metadata.len()
+        )));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_MODEL_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_MODEL_BYTES {
+        return Err(refuse(format!(
+            "grew beyond the {MAX_MODEL_BYTES} bytes a model file may have while it was read"
+        )));
+    }
+    Ok(bytes)
 }
 
 /// An `X1` diagnostic at the first byte that is not UTF-8.

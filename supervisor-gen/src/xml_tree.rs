@@ -34,6 +34,10 @@ impl Element {
     }
 }
 
+/// Deepest element nesting accepted: models nest four deep, and a limit keeps a hostile file from exhausting the
+/// stack of whatever walks (or drops) the tree.
+pub const MAX_DEPTH: usize = 256;
+
 /// Parses `text` into its root element, or the first well-formedness error as an `X1` diagnostic.
 pub(crate) fn parse(file: &str, text: &str) -> Result<Element, Diagnostic> {
     let index = LineIndex::new(text);
@@ -55,6 +59,15 @@ pub(crate) fn parse(file: &str, text: &str) -> Result<Element, Diagnostic> {
                 let element = element(file, &index, &start)?;
                 if root.is_some() {
                     return Err(x1(element.at, "content after the root element".into()));
+                }
+                if stack.len() >= MAX_DEPTH {
+                    return Err(x1(
+                        element.at,
+                        format!(
+                            "`<{}>` nests deeper than {MAX_DEPTH} elements",
+                            element.name
+                        ),
+                    ));
                 }
                 stack.push(element);
             }

@@ -455,3 +455,29 @@ fn report_lists_validation_warnings_with_their_locations() {
     );
     assert_eq!(warnings[0]["severity"], "warning");
 }
+
+#[test]
+fn a_device_or_a_deeply_nested_file_is_refused_with_its_name_not_read_forever_or_overflowed() {
+    let zero = run(&["check", "/dev/zero"]);
+    assert_eq!(zero.status.code(), Some(2));
+    assert!(
+        stderr(&zero).contains("/dev/zero") && stderr(&zero).contains("not a regular file"),
+        "{}",
+        stderr(&zero)
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let deep = dir.path().join("deep.xml");
+    let depth = 1_000_000;
+    std::fs::write(
+        &deep,
+        format!("{}{}", "<a>".repeat(depth), "</a>".repeat(depth)),
+    )
+    .expect("write");
+    let o = run(&["check", path(&deep)]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nests deeper than 256 elements"),
+        "{}",
+        stderr(&o)
+    );
+}
