@@ -117,16 +117,14 @@ impl Locator<'_> {
     }
 }
 
+/// Largest grid file read (grids are a few lines; the limit bounds what a wrong path can cost).
+pub const MAX_GRID_BYTES: u64 = 1024 * 1024;
+
 impl Grid {
     /// Reads and checks a grid file; on failure every error found, located in the grid file.
     pub fn load(path: &Path) -> Result<Grid, ConfigErrors> {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigErrors {
-            errors: vec![Diagnostic::new(
-                path.to_path_buf(),
-                Location::default(),
-                format!("cannot read the grid file: {e}"),
-            )],
-        })?;
+        let text = swarm_contract::config::input::read_text(path, MAX_GRID_BYTES)
+            .map_err(|d| ConfigErrors { errors: vec![d] })?;
         Grid::parse(path, &text)
     }
 
@@ -395,6 +393,13 @@ fn scalar_text(value: &toml::Value) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_device_or_a_fifo_is_refused_as_a_grid_without_being_read() {
+        let err = Grid::load(Path::new("/dev/zero")).expect_err("not a grid file");
+        assert!(err.to_string().contains("/dev/zero"), "{err}");
+        assert!(err.to_string().contains("is not a regular file"), "{err}");
+    }
 
     const GRID: &str = r#"
 base = "base.argos"

@@ -40,12 +40,11 @@ pub fn configurations(grid: &Grid) -> Result<Vec<Configuration>, ConfigErrors> {
             message,
         )],
     };
-    let base_text = std::fs::read_to_string(&grid.base).map_err(|e| {
-        fail(format!(
-            "cannot read the base configuration {}: {e}",
-            grid.base.display()
-        ))
-    })?;
+    let base_text = swarm_contract::config::input::read_text(
+        &grid.base,
+        swarm_contract::config::input::MAX_CONFIG_BYTES,
+    )
+    .map_err(|d| ConfigErrors { errors: vec![d] })?;
     let (_, base_warnings) = Experiment::parse(&grid.base, &base_text)?;
     let known_warnings: BTreeSet<String> = base_warnings.iter().map(message_of).collect();
     let document =
