@@ -231,7 +231,8 @@ pub fn run(
     }
     let path = options.out.join("bench.json");
     let json = serde_json::to_string_pretty(&report).unwrap_or_default();
-    std::fs::write(&path, json).map_err(|source| BenchError::Write { path, source })?;
+    swarm_contract::run_dir::write_atomically(&path, json.as_bytes())
+        .map_err(|source| BenchError::Write { path, source })?;
     Ok(report)
 }
 

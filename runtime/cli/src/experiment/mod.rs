@@ -385,5 +385,6 @@ fn summarise(
 
 fn write(root: &Path, name: &str, text: &str) -> Result<(), ExperimentError> {
     let path = root.join(name);
-    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))
+    swarm_contract::run_dir::write_atomically(&path, text.as_bytes())
+        .map_err(io(format!("writing {}", path.display())))
 }

@@ -132,7 +132,10 @@ impl BatchDir {
             ticks,
         };
         let text = serde_json::to_string_pretty(&marker).map_err(std::io::Error::other)?;
-        std::fs::write(partial.join(RUN_MARKER), text + "\n")?;
+        swarm_contract::run_dir::write_atomically(
+            &partial.join(RUN_MARKER),
+            (text + "\n").as_bytes(),
+        )?;
         let finished = self.run_dir(id, seed);
         std::fs::rename(&partial, &finished)?;
         Ok(finished)

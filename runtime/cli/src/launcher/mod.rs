@@ -482,7 +482,8 @@ fn check_controllers(
     }
     let path = out_dir.join(EVENT_TABLES_FILE);
     let text = serde_json::to_string_pretty(&serde_json::Value::Object(tables)).unwrap_or_default();
-    std::fs::write(&path, text).map_err(io(format!("writing {}", path.display())))?;
+    run_dir::write_atomically(&path, text.as_bytes())
+        .map_err(io(format!("writing {}", path.display())))?;
     Ok(compiled)
 }
 

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use swarm_contract::run_dir::{EVENTS_FILE, TRAJECTORY_FILE};
+use swarm_contract::run_dir::{self, EVENTS_FILE, TRAJECTORY_FILE};
 
 /// Cuts the records in `run_dir` back to the last complete tick of `robots` robots; returns that tick (`None`
 /// when the trajectory is missing or holds no complete tick).
@@ -32,7 +32,7 @@ pub fn trim_to_complete_ticks(run_dir: &Path, robots: u32) -> std::io::Result<Op
     }
     let kept = lines.join("\n") + "\n";
     if kept != text {
-        std::fs::write(&trajectory, kept)?;
+        run_dir::write_atomically(&trajectory, kept.as_bytes())?;
     }
     let events = run_dir.join(EVENTS_FILE);
     if let Ok(text) = std::fs::read_to_string(&events) {
@@ -40,7 +40,7 @@ pub fn trim_to_complete_ticks(run_dir: &Path, robots: u32) -> std::io::Result<Op
         kept.retain(|l| tick_of(l).is_none_or(|t| t <= last));
         let kept = kept.join("\n") + "\n";
         if kept != text {
-            std::fs::write(&events, kept)?;
+            run_dir::write_atomically(&events, kept.as_bytes())?;
         }
     }
     Ok(Some(last))

@@ -75,9 +75,7 @@ impl ResumePoint {
             "fired": fired,
         });
         // Written whole then renamed, so a reader never sees half a file.
-        let partial = path.with_extension("json.part");
-        std::fs::write(&partial, value.to_string()).map_err(io)?;
-        std::fs::rename(&partial, &path).map_err(io)?;
+        crate::run_dir::write_atomically(&path, value.to_string().as_bytes()).map_err(io)?;
         Ok(path)
     }
 
