@@ -1,4 +1,4 @@
-//! Shared helpers for the system tests in `tests/tests/system/`: build the real programs once, run `swarm` as a user
+//! Shared helpers for the system tests in `tests/tests/`: build the real programs once, run `swarm` as a user
 //! would, and check that a run leaves no process and no shared-memory file behind.
 //!
 //! Runs are recognised by their iceoryx2 run name, which the launcher derives from its own process id
