@@ -18,6 +18,7 @@ use robot_agent::from_config;
 use robot_agent::params::Params;
 use robot_agent::resume::Resumer;
 use swarm_contract::config::Experiment;
+use swarm_contract::limits::Limits;
 use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::protocol::launcher_to_agent::AgentArgs;
 use swarm_contract::protocol::resume::ResumePoint;
@@ -61,8 +62,9 @@ fn parse_param(s: &str) -> Result<(String, String), String> {
     }
 }
 
-/// Plans and builds the robot's controller from the configuration or from the manual flags.
-fn build_control(args: &Args) -> Result<(Plan, Control)> {
+/// Plans and builds the robot's controller from the configuration or from the manual flags; also the run's limits
+/// (the configuration's `<system>` ones with the command line's `--limit` overrides).
+fn build_control(args: &Args) -> Result<(Plan, Control, Limits)> {
     if let Some(path) = &args.agent.config {
         let (experiment, warnings) =
             Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
@@ -97,7 +99,9 @@ fn build_control(args: &Args) -> Result<(Plan, Control)> {
             controller = controller.id.as_str(),
             seed, "robot runs {plan}"
         );
-        return Ok((plan, control));
+        let mut limits = experiment.framework.limits;
+        limits.apply(&args.agent.limits)?;
+        return Ok((plan, control, limits));
     }
     let mut pairs = args.params.clone();
     if let (Some(profile), Some(supervisors)) = (&args.profile, &args.supervisors) {
@@ -110,7 +114,9 @@ fn build_control(args: &Args) -> Result<(Plan, Control)> {
     let seed = args.agent.seed.unwrap_or(0);
     let control = control::build(&plan, &params, seed, args.agent.robot)?;
     info!(seed, "robot runs {plan}");
-    Ok((plan, control))
+    let mut limits = Limits::default();
+    limits.apply(&args.agent.limits)?;
+    Ok((plan, control, limits))
 }
 
 /// Writes the compiled supervisor set of `plan` to `path` (nothing for a native controller).
@@ -123,19 +129,17 @@ fn write_supervisors(plan: &Plan, path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// How long a replacement agent keeps trying to join while the world frees its dead predecessor's ports.
-const JOIN_RETRY: Duration = Duration::from_secs(10);
 /// Pause between two attempts to join.
 const JOIN_RETRY_PAUSE: Duration = Duration::from_millis(20);
 
 /// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports and
 /// the node place of the agent it replaces (iceoryx2 offers no notification of that), so an exhausted limit is
-/// retried for a while.
-fn join(run: &RunSpec, robot: u32) -> Result<AgentLink> {
+/// retried for a while ([`Limits::agent_join_retry_ms`]).
+fn join(run: &RunSpec, robot: u32, limits: &Limits) -> Result<AgentLink> {
     let started = Instant::now();
     loop {
-        match AgentLink::join(run, robot) {
-            Err(e) if limit_reached(&e) && started.elapsed() < JOIN_RETRY => {
+        match AgentLink::join_waiting(run, robot, limits.agent_board_wait()) {
+            Err(e) if limit_reached(&e) && started.elapsed() < limits.agent_join_retry() => {
                 std::thread::sleep(JOIN_RETRY_PAUSE);
             }
             other => return Ok(other?),
@@ -153,7 +157,12 @@ fn limit_reached(error: &TransportError) -> bool {
 }
 
 /// Answers every tick of the run until the world ends it.
-fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<()> {
+fn serve(
+    args: &Args,
+    root: &std::path::Path,
+    control: &mut Control,
+    limits: &Limits,
+) -> Result<()> {
     let point = match &args.agent.resume {
         Some(path) => Some(ResumePoint::read(path)?),
         None => None,
@@ -161,7 +170,7 @@ fn serve(args: &Args, root: &std::path::Path, control: &mut Control) -> Result<(
     let mut resumer = Resumer::new(point);
     let run = RunSpec::new(&args.agent.run, root)?;
     let slot = args.agent.slot.unwrap_or(args.agent.robot);
-    let mut link = join(&run, slot)?;
+    let mut link = join(&run, slot, limits)?;
     info!(
         run = args.agent.run.as_str(),
         robot = args.agent.robot,
@@ -226,7 +235,7 @@ fn run(args: &Args) -> Result<()> {
     if args.agent.iox_root.is_none() && !args.check {
         anyhow::bail!("--iox-root is required to join a run (only --check works without it)");
     }
-    let (plan, mut control) = build_control(args)
+    let (plan, mut control, limits) = build_control(args)
         .with_context(|| format!("robot {}: cannot start its controller", args.agent.robot))?;
     let Some(root) = args.agent.iox_root.as_deref().filter(|_| !args.check) else {
         if let Some(path) = &args.write_supervisors {
@@ -237,7 +246,7 @@ fn run(args: &Args) -> Result<()> {
         return Ok(());
     };
     install_stop_handler()?;
-    serve(args, root, &mut control)
+    serve(args, root, &mut control, &limits)
         .with_context(|| format!("robot {} in run {}", args.agent.robot, args.agent.run))
 }
 

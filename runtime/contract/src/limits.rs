@@ -38,6 +38,12 @@ pub struct Limits {
     pub ctl_reply_timeout_ms: u64,
     /// Largest message the world accepts from a host, in bytes. Default 16 MiB.
     pub max_host_message_bytes: u64,
+    /// How long a replacement agent keeps trying to join while the world frees the ports of the agent it
+    /// replaces, in milliseconds. Default 10,000.
+    pub agent_join_retry_ms: u64,
+    /// How long a joining agent waits for the death notice of its robot's previous agent and for the world to
+    /// replace the robot's command board, in milliseconds. Default 30,000.
+    pub agent_board_wait_ms: u64,
 }
 
 /// Largest message the world accepts from a host by default.
@@ -53,6 +59,8 @@ impl Default for Limits {
             fault_apply_timeout_ms: 30_000,
             ctl_reply_timeout_ms: 10_000,
             max_host_message_bytes: DEFAULT_MAX_HOST_MESSAGE_BYTES,
+            agent_join_retry_ms: 10_000,
+            agent_board_wait_ms: 30_000,
         }
     }
 }
@@ -81,7 +89,7 @@ pub enum LimitError {
 
 impl Limits {
     /// The names of the limits, as `<system>` attributes and `--limit` names.
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 9] = [
         "tick_deadline_ms",
         "join_timeout_ms",
         "world_ready_timeout_ms",
@@ -89,6 +97,8 @@ impl Limits {
         "fault_apply_timeout_ms",
         "ctl_reply_timeout_ms",
         "max_host_message_bytes",
+        "agent_join_retry_ms",
+        "agent_board_wait_ms",
     ];
 
     fn field(&mut self, name: &str) -> Option<&mut u64> {
@@ -100,6 +110,8 @@ impl Limits {
             "fault_apply_timeout_ms" => &mut self.fault_apply_timeout_ms,
             "ctl_reply_timeout_ms" => &mut self.ctl_reply_timeout_ms,
             "max_host_message_bytes" => &mut self.max_host_message_bytes,
+            "agent_join_retry_ms" => &mut self.agent_join_retry_ms,
+            "agent_board_wait_ms" => &mut self.agent_board_wait_ms,
             _ => return None,
         })
     }
@@ -160,6 +172,16 @@ impl Limits {
     /// [`Limits::ctl_reply_timeout_ms`] as a duration.
     pub fn ctl_reply_timeout(&self) -> Duration {
         Duration::from_millis(self.ctl_reply_timeout_ms)
+    }
+
+    /// [`Limits::agent_join_retry_ms`] as a duration.
+    pub fn agent_join_retry(&self) -> Duration {
+        Duration::from_millis(self.agent_join_retry_ms)
+    }
+
+    /// [`Limits::agent_board_wait_ms`] as a duration.
+    pub fn agent_board_wait(&self) -> Duration {
+        Duration::from_millis(self.agent_board_wait_ms)
     }
 
     /// [`Limits::max_host_message_bytes`] as a size.

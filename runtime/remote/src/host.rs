@@ -510,6 +510,7 @@ impl Share {
             .any(|(id, _)| id == controller)
             .then(|| run_dir::compiled_supervisors(&self.logs, controller));
         args.robots = self.assignment.robots_override;
+        args.limits = self.assignment.limits.clone();
         args.resume = resume;
         let log_path = log_file(&self.logs, *robot);
         let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {

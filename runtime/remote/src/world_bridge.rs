@@ -74,6 +74,8 @@ pub struct RemoteOptions {
     pub max_payload: usize,
     /// The run's compiled supervisor sets by controller id, handed to every host with its share.
     pub compiled_supervisors: Vec<(String, Vec<u8>)>,
+    /// The run's `--limit` overrides, handed to every host for its agents.
+    pub limits: Vec<String>,
 }
 
 /// What happened to a host during the run.
@@ -559,6 +561,7 @@ impl RemoteHosts {
             pin_agents: self.options.pin_agents,
             realtime_priority: self.options.realtime_priority,
             compiled_supervisors: self.options.compiled_supervisors.clone(),
+            limits: self.options.limits.clone(),
             resume: if host.epoch > 1 {
                 host.share
                     .robots
@@ -1037,6 +1040,7 @@ mod tests {
             realtime_priority: false,
             max_payload: codec::DEFAULT_MAX_PAYLOAD,
             compiled_supervisors: Vec::new(),
+            limits: Vec::new(),
         };
         RemoteHosts::start(options, robots, 0x5eed).expect("the world listens")
     }

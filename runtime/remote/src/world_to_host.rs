@@ -58,6 +58,8 @@ pub struct Assignment {
     /// controller id: the host's agents load these instead of compiling the models themselves. A native
     /// controller has none.
     pub compiled_supervisors: Vec<(String, Vec<u8>)>,
+    /// The run's `--limit` overrides (`NAME=VALUE`), passed on to the host's agents.
+    pub limits: Vec<String>,
     /// For a host that rejoins: each robot's last recorded supervisor snapshot and the tick it came with, in the
     /// order of `robots`, so its fresh agent resumes where the robot left off. Empty on the first assignment.
     pub resume: Vec<(u64, SupervisorSnapshot)>,

@@ -89,6 +89,7 @@ impl Link {
             realtime_priority,
             max_payload: limits.max_host_message(),
             compiled_supervisors,
+            limits: args.limits.clone(),
         };
         let run = SystemTime::now()
             .duration_since(UNIX_EPOCH)

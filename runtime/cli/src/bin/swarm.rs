@@ -73,7 +73,8 @@ enum Commands {
         join_timeout_ms: Option<u64>,
         /// A timeout or size limit, overriding the configuration's <system> attribute of the same name
         /// (repeatable): tick_deadline_ms, join_timeout_ms, world_ready_timeout_ms, agent_exit_grace_ms,
-        /// fault_apply_timeout_ms, ctl_reply_timeout_ms, max_host_message_bytes (docs/configuration.md).
+        /// fault_apply_timeout_ms, ctl_reply_timeout_ms, max_host_message_bytes, agent_join_retry_ms,
+        /// agent_board_wait_ms (docs/configuration.md).
         #[arg(long = "limit", value_name = "NAME=VALUE")]
         limits: Vec<String>,
         /// Do not draw a progress bar.

@@ -98,6 +98,8 @@ pub struct AgentSpawner {
     pub out_dir: PathBuf,
     /// Each supervised controller's supervisor set, compiled once for the run, by controller id.
     pub compiled: HashMap<String, PathBuf>,
+    /// The run's `--limit` overrides, passed on to every agent.
+    pub limits: Vec<String>,
 }
 
 impl AgentSpawner {
@@ -113,6 +115,7 @@ impl AgentSpawner {
         args.robots = self.robots;
         args.compiled_supervisors = self.compiled.get(controller).cloned();
         args.resume = resume;
+        args.limits = self.limits.clone();
         let log_path = run_dir::agent_log(&self.out_dir, robot);
         let log = OpenOptions::new()
             .create(true)

@@ -350,6 +350,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         robots: options.robots,
         out_dir: out_dir.clone(),
         compiled,
+        limits: options.limits.clone(),
     };
     let progress = progress_bar(options.progress, ticks, robots);
     let mut supervision = Supervision {

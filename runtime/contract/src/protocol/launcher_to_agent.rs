@@ -80,6 +80,10 @@ pub struct AgentArgs {
     /// Resume point of a restarted robot ([`crate::protocol::resume`]): its supervisors continue from it.
     #[arg(long)]
     pub resume: Option<PathBuf>,
+    /// Limits overriding the configuration's `<system>` ones, as NAME=VALUE (repeatable; see
+    /// [`Limits`](crate::limits::Limits)): the run's `swarm run --limit` flags.
+    #[arg(long = "limit", value_name = "NAME=VALUE")]
+    pub limits: Vec<String>,
 }
 
 impl AgentArgs {
@@ -103,6 +107,7 @@ impl AgentArgs {
             robots: None,
             compiled_supervisors: None,
             resume: None,
+            limits: Vec::new(),
         }
     }
 
@@ -128,6 +133,9 @@ impl AgentArgs {
         option("--robots", self.robots.map(|r| r.to_string()));
         option("--compiled-supervisors", path(&self.compiled_supervisors));
         option("--resume", path(&self.resume));
+        for limit in &self.limits {
+            args.extend(["--limit".to_owned(), limit.clone()]);
+        }
         args
     }
 }
@@ -171,6 +179,7 @@ pub(crate) mod tests {
         args.robots = Some(40);
         args.compiled_supervisors = Some(PathBuf::from("runs/x/supervisors/fdc.ptsct"));
         args.resume = Some(PathBuf::from("runs/x/resume/robot-7.json"));
+        args.limits = vec!["agent_join_retry_ms=500".into()];
         let line = std::iter::once("robot-agent".to_string()).chain(args.to_args());
         assert_eq!(Agent::parse_from(line).args, args);
     }

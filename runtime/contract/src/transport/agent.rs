@@ -27,9 +27,6 @@ use super::world_watch::WorldWatch;
 use super::{placement, priority};
 use crate::messages::{ActuatorCommand, SensorFrame};
 
-/// How long a joining agent waits for the death notice of its robot's dead agent, and then for the world to
-/// replace the robot's command board.
-const BOARD_WAIT: Duration = Duration::from_secs(30);
 /// Default number of polls of the chain's wake word before an agent sleeps on it (see [`AgentLink::set_spin`]).
 pub const DEFAULT_AGENT_SPIN: u32 = 0;
 
@@ -90,18 +87,32 @@ pub struct AgentLink {
 }
 
 impl AgentLink {
+    /// Joins robot `robot` of `run` with the default board wait
+    /// ([`Limits::agent_board_wait_ms`](crate::limits::Limits)); see [`AgentLink::join_waiting`].
+    pub fn join(run: &RunSpec, robot: u32) -> Result<AgentLink, TransportError> {
+        AgentLink::join_waiting(
+            run,
+            robot,
+            crate::limits::Limits::default().agent_board_wait(),
+        )
+    }
+
     /// Joins `run` as the agent of `robot`. Fails with a message naming the limit when the run has no place for
     /// it, or when another live agent already runs this robot.
-    pub fn join(run: &RunSpec, robot: u32) -> Result<AgentLink, TransportError> {
+    pub fn join_waiting(
+        run: &RunSpec,
+        robot: u32,
+        board_wait: Duration,
+    ) -> Result<AgentLink, TransportError> {
         let sync = Arc::new(SyncBlock::open(&run.sync_block_path())?);
         let capacity = sync.capacity();
         if robot >= capacity {
             return Err(TransportError::RobotOutOfRange { robot, capacity });
         }
-        if let JoinClaim::Taken = sync.claim_robot(robot, Instant::now() + BOARD_WAIT) {
+        if let JoinClaim::Taken = sync.claim_robot(robot, Instant::now() + board_wait) {
             return Err(TransportError::RobotTaken { robot });
         }
-        match Self::connect(run, robot, &sync) {
+        match Self::connect(run, robot, &sync, board_wait) {
             Ok(ports) => {
                 let placement = sync.placement();
                 if placement.pin_chains {
@@ -137,14 +148,19 @@ impl AgentLink {
         }
     }
 
-    fn connect(run: &RunSpec, robot: u32, sync: &SyncBlock) -> Result<Ports, TransportError> {
+    fn connect(
+        run: &RunSpec,
+        robot: u32,
+        sync: &SyncBlock,
+        board_wait: Duration,
+    ) -> Result<Ports, TransportError> {
         if sync.is_dead(robot) {
             // A replacement: the dead agent may still hold the writer slot of the robot's current board.
             sync.request_board(robot);
         }
         let waited = Instant::now();
         let generation =
-            sync.wait_board(robot, waited + BOARD_WAIT)
+            sync.wait_board(robot, waited + board_wait)
                 .ok_or(TransportError::NoCommandBoard {
                     robot,
                     waited_ms: waited.elapsed().as_millis(),
