@@ -201,11 +201,21 @@ pub fn snapshot(run_dir: &Path, tick: u64) -> PathBuf {
     run_dir.join(format!("snapshot_{tick:06}.png"))
 }
 
-/// The compiled supervisor set of controller `controller`.
-pub fn compiled_supervisors(run_dir: &Path, controller: &str) -> PathBuf {
-    run_dir
+/// The compiled supervisor set of controller `controller`; refused for an id that is not a plain file name (one
+/// that would name a file outside the folder, such as `../x`), since ids also arrive from hosts' peers.
+pub fn compiled_supervisors(run_dir: &Path, controller: &str) -> std::io::Result<PathBuf> {
+    let plain = !controller.is_empty()
+        && !controller.starts_with('.')
+        && !controller.contains(['/', '\\', '\0']);
+    if !plain {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("controller id {controller:?} is not a plain file name"),
+        ));
+    }
+    Ok(run_dir
         .join(COMPILED_SUPERVISORS_DIR)
-        .join(format!("{controller}.ptsct"))
+        .join(format!("{controller}.ptsct")))
 }
 
 /// The last `lines` non-empty lines of a log, for error messages.

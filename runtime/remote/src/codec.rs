@@ -1,9 +1,9 @@
 //! The cross-host wire format: a versioned header and a batch of per-robot entries, bincode 2 encoded.
 //!
 //! One message carries one host's share of one tick: `[Header][count: u32][count x (robot: u32, entry)]`, where an
-//! entry is a [`SensorFrame`](swarm_contract::messages::SensorFrame) (world to host) or a [`Reply`] (host to world). Every
-//! field is encoded explicitly (bincode, little-endian, variable-length integers), never as raw memory, so hosts of
-//! different architectures interoperate. Decoding checks the size, magic, version, kind and that the robots are
+//! entry is a [`SensorFrame`](swarm_contract::messages::SensorFrame) (world to host) or a
+//! [`Reply`](crate::host_to_world::Reply) (host to world). Every field is encoded explicitly (bincode,
+//! little-endian, variable-length integers), never as raw memory, so hosts of different architectures interoperate. Decoding checks the size, magic, version, kind and that the robots are
 //! exactly the ones the receiver expects, in order; decoding into a caller's slice allocates nothing.
 //!
 //! This module must never panic on a payload: whatever arrives from the network is either decoded or rejected with

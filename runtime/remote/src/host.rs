@@ -404,13 +404,7 @@ impl Share {
             });
         }
         let run = assignment.run;
-        let removed = RunSpec::remove_dead_runs();
-        if removed > 0 {
-            tracing::info!(
-                removed,
-                "removed the shared memory of runs whose daemon was killed"
-            );
-        }
+        RunSpec::remove_dead_runs();
         let spec = RunSpec::unique();
         let mut link_config = LinkConfig::new(count.max(1));
         link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);
@@ -508,7 +502,8 @@ impl Share {
             .compiled_supervisors
             .iter()
             .any(|(id, _)| id == controller)
-            .then(|| run_dir::compiled_supervisors(&self.logs, controller));
+            .then(|| run_dir::compiled_supervisors(&self.logs, controller).ok())
+            .flatten();
         args.robots = self.assignment.robots_override;
         args.limits = self.assignment.limits.clone();
         args.resume = resume;
@@ -789,25 +784,12 @@ fn log_file(logs: &Path, robot: u32) -> PathBuf {
 /// run directory).
 fn write_compiled_supervisors(logs: &Path, sets: &[(String, Vec<u8>)]) -> Result<(), RemoteError> {
     for (controller, bytes) in sets {
-        let plain_name = !controller.is_empty()
-            && !controller.starts_with('.')
-            && !controller.contains(['/', '\\', '\0']);
-        if !plain_name {
-            return Err(RemoteError::Io {
-                what: format!("a compiled supervisor set for controller {controller:?}"),
-                source: std::io::Error::new(
-                    std::io::ErrorKind::InvalidInput,
-                    "a controller id must be a plain file name",
-                ),
-            });
-        }
-        let path = run_dir::compiled_supervisors(logs, controller);
-        let written = path
-            .parent()
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .and_then(|()| std::fs::write(&path, bytes));
+        let written = run_dir::compiled_supervisors(logs, controller).and_then(|path| {
+            std::fs::create_dir_all(logs.join(run_dir::COMPILED_SUPERVISORS_DIR))?;
+            run_dir::write_atomically(&path, bytes)
+        });
         written.map_err(|source| RemoteError::Io {
-            what: format!("writing {}", path.display()),
+            what: format!("writing the compiled supervisor set of controller {controller:?}"),
             source,
         })?;
     }

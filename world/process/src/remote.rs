@@ -40,7 +40,7 @@ fn compiled_supervisors(
     ids.dedup();
     let mut sets = Vec::new();
     for id in ids {
-        let path = run_dir::compiled_supervisors(run_dir, id);
+        let path = run_dir::compiled_supervisors(run_dir, id)?;
         if path.is_file() {
             let bytes =
                 std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;

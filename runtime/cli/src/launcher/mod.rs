@@ -1,8 +1,8 @@
 //! The launcher behind `swarm run`: validates an experiment, starts the world process and one robot-agent
 //! process per robot, supervises them, and leaves a complete run directory and no shared-memory files behind.
 //!
-//! It never simulates or controls anything itself: the world and the agents are separate programs
-//! ([`binaries`]) that speak the [`process_args`] and [`world_report`] contracts with it.
+//! It never simulates or controls anything itself: the world and the agents are separate programs (found by
+//! `swarm_contract::process::binaries`) that speak the protocol of `swarm_contract::protocol` with it.
 //!
 //! Order of a run: load and validate the configuration (all errors at once, located) -> resolve seed, ticks and
 //! robots -> create the run directory -> start the world (it creates every shared-memory service with limits
@@ -45,8 +45,7 @@ use swarm_contract::config::{ConfigErrors, Experiment};
 use swarm_contract::fault_plan::FaultPlan;
 use swarm_contract::limits::LimitError;
 use swarm_contract::process::binaries::{Binaries, BinariesError};
-use swarm_contract::process::children;
-use swarm_contract::process::children::Children;
+use swarm_contract::process::children::{self, Children};
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs};
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::protocol::launcher_to_world::WorldCommand;
@@ -84,7 +83,7 @@ pub struct RunOptions {
     pub real_time: bool,
     /// Faults added to the configuration's `<faults>` (`swarm run --fault`, e.g. `kill robots=3 tick=50`).
     pub faults: Vec<String>,
-    /// Hosts to run the robots on instead of locally (see [`hosts`]).
+    /// Hosts to run the robots on instead of locally (see [`swarm_remote::plan`]).
     pub hosts: HostsArgs,
 }
 
@@ -255,13 +254,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let run_folder = run_dir::create(options.out.as_deref(), options.overwrite, &options.config)?;
     let out_dir = run_folder.path.clone();
     let binaries = Binaries::locate()?;
-    let removed = RunSpec::remove_dead_runs();
-    if removed > 0 {
-        tracing::info!(
-            removed,
-            "removed the shared memory of runs whose launcher was killed"
-        );
-    }
+    RunSpec::remove_dead_runs();
     let spec = RunSpec::unique();
     let _shared_memory = SharedMemoryGuard(spec.clone());
     let run_args = RunArgs {
@@ -447,7 +440,8 @@ fn check_controllers(
         }
         let mut args = AgentArgs::launched(run_args, robot.index, config, controller, seed);
         args.robots = robots;
-        let compiled_file = run_dir::compiled_supervisors(out_dir, controller);
+        let compiled_file = run_dir::compiled_supervisors(out_dir, controller)
+            .map_err(io("naming the compiled supervisors"))?;
         let output = Command::new(&binaries.agent)
             .args(args.to_args())
             .arg("--check")

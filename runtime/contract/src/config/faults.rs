@@ -643,15 +643,12 @@ mod tests {
     use super::*;
 
     /// The sections after `<faults>` that make the experiment complete (one controller, `oa`).
-    const REST: &str = "<controllers><test_controller id=\"oa\" library=\"agent\"><actuators/><sensors/>\
-        <params/></test_controller></controllers>\n<arena size=\"1,1,1\" center=\"0,0,0.5\"/>\n\
-        <physics_engines><dynamics2d id=\"d\"/></physics_engines>\n<media/>";
-
     /// An experiment whose `<faults>` section starts on line 3.
     fn experiment(faults: &str) -> Result<Experiment, ConfigErrors> {
         let text = format!(
             "<argos-configuration>\n<framework><experiment length=\"10\" ticks_per_second=\"10\"/></framework>\n\
-             {faults}\n{REST}\n</argos-configuration>\n"
+             {faults}\n{}\n</argos-configuration>\n",
+            crate::config::TEST_SECTIONS
         );
         Experiment::parse("x.argos", &text).map(|(experiment, _)| experiment)
     }

@@ -312,9 +312,8 @@ mod tests {
         let path = dir.join("x.argos");
         let text = format!(
             "<argos-configuration>\n<framework>\n<experiment length=\"10\" ticks_per_second=\"10\" />\n{hosts}\n\
-             </framework>\n<controllers><test_controller id=\"c\" library=\"agent\"><actuators/><sensors/>\
-             <params/></test_controller></controllers>\n<arena size=\"1,1,1\" center=\"0,0,0.5\"/>\n\
-             <physics_engines><dynamics2d id=\"d\"/></physics_engines>\n<media/>\n</argos-configuration>\n"
+             </framework>\n{}\n</argos-configuration>\n",
+            crate::config::TEST_SECTIONS
         );
         std::fs::write(&path, text).expect("write");
         path

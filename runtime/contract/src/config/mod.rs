@@ -42,3 +42,10 @@ impl Experiment {
         parse::parse_str(path.as_ref(), text)
     }
 }
+
+/// The sections that complete a test experiment after its `<framework>` (and any section under test): one
+/// controller `oa`, a small empty arena, the physics engine and no media.
+#[cfg(test)]
+pub(crate) const TEST_SECTIONS: &str = "<controllers><test_controller id=\"oa\" library=\"agent\"><actuators/>\
+    <sensors/><params/></test_controller></controllers>\n<arena size=\"1,1,1\" center=\"0,0,0.5\"/>\n\
+    <physics_engines><dynamics2d id=\"d\"/></physics_engines>\n<media/>";

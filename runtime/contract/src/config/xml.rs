@@ -211,7 +211,7 @@ fn open_element(
         .get(content_start..content_start + content_len)
         .unwrap_or("");
 
-    let mut attributes = BTreeMap::new();
+    let mut attributes: BTreeMap<String, Attribute> = BTreeMap::new();
     let mut cursor = name.len();
     // quick-xml's own duplicate check compares each attribute with every earlier one (quadratic in their
     // number); the map below finds duplicates in logarithmic time instead.
@@ -242,7 +242,6 @@ fn open_element(
         cursor = after;
         let location = index.locate(content_start + key_at);
         if let Some(first) = attributes.get(&key) {
-            let first: &Attribute = first;
             return Err((
                 content_start + key_at,
                 format!(

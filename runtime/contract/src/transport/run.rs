@@ -145,8 +145,8 @@ impl RunSpec {
     /// Removes the files of every run on this host whose launcher (or host daemon) is gone: a run named by
     /// [`RunSpec::unique`] carries its creator's process id, and a run whose creator no longer exists was killed
     /// before it could clean up (SIGKILL, power loss). Runs of a living process are left alone, whatever that
-    /// process is, so a reused process id can only keep files, never remove a live run's. Returns the number of
-    /// entries removed.
+    /// process is, so a reused process id can only keep files, never remove a live run's. Logs and returns the
+    /// number of entries removed.
     pub fn remove_dead_runs() -> usize {
         let mut dead: Vec<String> = std::fs::read_dir(SHM_DIR)
             .into_iter()
@@ -178,6 +178,12 @@ impl RunSpec {
                 Ok(n) => removed += n,
                 Err(e) => tracing::warn!("removing the files of the dead run {name}: {e}"),
             }
+        }
+        if removed > 0 {
+            tracing::info!(
+                removed,
+                "removed the shared memory of runs whose launcher or host daemon was killed"
+            );
         }
         removed
     }
