@@ -86,7 +86,7 @@ struct Dropped {
 
 /// Runs the daemon until `stop` is set.
 pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError> {
-    keys::check_host_name(&options.name)?;
+    swarm_contract::config::hosts::check_host_name(&options.name)?;
     let binaries = Binaries::locate()?;
     std::fs::create_dir_all(&options.logs).map_err(|source| RemoteError::Io {
         what: format!("creating {}", options.logs.display()),

@@ -7,15 +7,6 @@
 //! - `swarm/runs/<run>/world`: the world's liveliness token while the run lasts (hosts end their share when it goes).
 //! - `swarm/runs/<run>/frames/<host>` and `swarm/runs/<run>/replies/<host>`: one message per host per tick each way.
 
-use super::RemoteError;
-
-/// Checks that `name` can name a host (see [`swarm_contract::config::hosts::check_host_name`]).
-pub fn check_host_name(name: &str) -> Result<(), RemoteError> {
-    swarm_contract::config::hosts::check_host_name(name).map_err(|_| RemoteError::InvalidHostName {
-        name: name.to_owned(),
-    })
-}
-
 /// Every host's liveliness token.
 pub const HOSTS_WILDCARD: &str = "swarm/hosts/*";
 
@@ -73,16 +64,6 @@ pub fn host_of_replies(key: &str) -> Option<&str> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn host_names_are_one_key_chunk() {
-        for good in ["a", "host-1", "rack_2"] {
-            assert!(check_host_name(good).is_ok(), "{good}");
-        }
-        for bad in ["", "a/b", "*", "a b", "h$", &"x".repeat(65)] {
-            assert!(check_host_name(bad).is_err(), "{bad}");
-        }
-    }
 
     #[test]
     fn keys_give_back_their_host() {

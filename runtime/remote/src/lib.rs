@@ -29,11 +29,8 @@ pub mod world_to_host;
 #[derive(Debug, thiserror::Error)]
 pub enum RemoteError {
     /// A host name that cannot be a key chunk.
-    #[error("invalid host name '{name}': use 1-64 ASCII letters, digits, '-' or '_'")]
-    InvalidHostName {
-        /// The rejected name.
-        name: String,
-    },
+    #[error(transparent)]
+    InvalidHostName(#[from] swarm_contract::config::hosts::InvalidHostName),
     /// A zenoh operation failed.
     #[error("zenoh: {action}: {detail}")]
     Zenoh {

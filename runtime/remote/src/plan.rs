@@ -10,11 +10,10 @@ use std::time::Duration;
 
 use clap::Args;
 
-use crate::keys::check_host_name;
 use crate::session::{DEFAULT_LEASE, DEFAULT_LISTEN, ZenohOptions};
 use crate::world_bridge::HostShare;
-use swarm_contract::config::hosts::HostsConfig;
 use swarm_contract::config::hosts::TlsFileError;
+use swarm_contract::config::hosts::{HostsConfig, check_host_name};
 
 /// Flags of `swarm run` and of the world process that place robots on hosts.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Args)]

@@ -209,7 +209,7 @@ impl RemoteHosts {
         run: u64,
     ) -> Result<RemoteHosts, RemoteError> {
         for host in &options.hosts {
-            keys::check_host_name(&host.name)?;
+            swarm_contract::config::hosts::check_host_name(&host.name)?;
         }
         let session = options.zenoh.open_world(&options.listen)?;
         let (sender, incoming) = mpsc::channel();

@@ -329,6 +329,16 @@ mod tests {
     }
 
     #[test]
+    fn host_names_are_one_zenoh_key_chunk() {
+        for good in ["a", "host-1", "rack_2"] {
+            assert!(check_host_name(good).is_ok(), "{good}");
+        }
+        for bad in ["", "a/b", "*", "a b", "h$", &"x".repeat(65)] {
+            assert!(check_host_name(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
     fn hosts_with_weights_and_paths_relative_to_the_experiment() {
         let dir = tempfile::tempdir().expect("a temporary directory");
         let path = write_experiment(
