@@ -216,6 +216,48 @@ pub fn free_port(ip: &str) -> u16 {
         .expect("a free port")
 }
 
+/// The host keys of one test, made by `swarm host-key` in a temporary folder removed when dropped.
+pub struct TestKeys {
+    dir: tempfile::TempDir,
+}
+
+impl Default for TestKeys {
+    fn default() -> Self {
+        TestKeys::new()
+    }
+}
+
+impl TestKeys {
+    /// An empty key folder.
+    pub fn new() -> TestKeys {
+        TestKeys {
+            dir: tempfile::tempdir().expect("a temporary directory"),
+        }
+    }
+
+    /// The key folder (`swarm run --keys`).
+    pub fn dir(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// The key file of host `name`, created with `swarm host-key` if missing.
+    pub fn key(&self, name: &str) -> PathBuf {
+        let dir = self.dir().display().to_string();
+        let outcome = swarm(&["host-key", name, "--dir", &dir]);
+        assert!(
+            outcome.output.status.success(),
+            "swarm host-key {name} failed:\n{}",
+            outcome.stderr()
+        );
+        self.dir().join(format!("{name}.key"))
+    }
+
+    /// `--keys <folder>` for `swarm run`.
+    pub fn run_args(&self) -> Vec<String> {
+        vec!["--keys".into(), self.dir().display().to_string()]
+    }
+}
+
 /// A `swarm host` daemon started by a test (optionally inside a network namespace). Its log lines are collected
 /// so the test can wait for events; dropping it kills it and removes whatever its runs left.
 pub struct HostDaemon {
@@ -228,9 +270,15 @@ pub struct HostDaemon {
 }
 
 impl HostDaemon {
-    /// Starts `swarm host --connect <connect> --name <name>`, inside `netns` when given.
-    pub fn start(name: &str, connect: &str, netns: Option<&str>) -> HostDaemon {
-        HostDaemon::start_with(name, connect, netns, &[])
+    /// Starts `swarm host --connect <connect> --name <name> --key <its key in keys>`, inside `netns` when given.
+    pub fn start(name: &str, connect: &str, netns: Option<&str>, keys: &TestKeys) -> HostDaemon {
+        let key = keys.key(name);
+        HostDaemon::start_with(
+            name,
+            connect,
+            netns,
+            &[std::ffi::OsStr::new("--key"), key.as_os_str()],
+        )
     }
 
     /// Like [`HostDaemon::start`], with more `swarm host` flags (e.g. credentials).

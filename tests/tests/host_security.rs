@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use rcgen::{BasicConstraints, CertificateParams, DnType, IsCa, Issuer, KeyPair};
-use swarm_system_tests::{HostDaemon, assert_clean, free_port, swarm, workspace_file};
+use swarm_system_tests::{HostDaemon, TestKeys, assert_clean, free_port, swarm, workspace_file};
 
 const EXPERIMENT: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
 /// How long the refused run waits for its host: long enough for many connection attempts.
@@ -40,7 +40,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 /// Runs `experiment` on the host `name` with extra flags; returns whether it succeeded and its stderr.
-fn run_on(experiment: &Path, name: &str, flags: &[&str]) -> (bool, String) {
+fn run_on(experiment: &Path, name: &str, keys: &TestKeys, flags: &[&str]) -> (bool, String) {
     let out = tempfile::tempdir().expect("a temporary directory");
     let experiment = experiment.display().to_string();
     let out_dir = out.path().display().to_string();
@@ -57,6 +57,8 @@ fn run_on(experiment: &Path, name: &str, flags: &[&str]) -> (bool, String) {
         "--hosts",
         name,
     ];
+    let key_args = keys.run_args();
+    args.extend(key_args.iter().map(String::as_str));
     args.extend(flags);
     let outcome = swarm(&args);
     assert_clean(&outcome);
@@ -66,10 +68,11 @@ fn run_on(experiment: &Path, name: &str, flags: &[&str]) -> (bool, String) {
 /// The member joins and runs its share; the intruder never connects and a run naming it gives up.
 fn member_joins_and_intruder_is_refused(
     experiment: &Path,
+    keys: &TestKeys,
     mut member: HostDaemon,
     mut intruder: HostDaemon,
 ) {
-    let (ok, stderr) = run_on(experiment, &member.name.clone(), &[]);
+    let (ok, stderr) = run_on(experiment, &member.name.clone(), keys, &[]);
     assert!(ok, "the run on the member host failed:\n{stderr}");
     assert!(
         member.wait_for("share started", CONNECT_TIMEOUT),
@@ -80,6 +83,7 @@ fn member_joins_and_intruder_is_refused(
     let (ok, stderr) = run_on(
         experiment,
         &intruder.name.clone(),
+        keys,
         &["--join-timeout-ms", REFUSED_JOIN_TIMEOUT_MS],
     );
     assert!(!ok, "a run on the intruder host succeeded:\n{stderr}");
@@ -109,12 +113,16 @@ fn a_host_with_the_password_joins_and_one_with_a_wrong_password_is_refused() {
             r#"<hosts listen="{endpoint}" user="swarm" password_file="world-password" credentials_file="credentials"><host name="member" /></hosts>"#
         ),
     );
+    let keys = TestKeys::new();
     let daemon = |name: &str, password: &Path| {
+        let key = keys.key(name);
         HostDaemon::start_with(
             name,
             &endpoint,
             None,
             &[
+                OsStr::new("--key"),
+                key.as_os_str(),
                 OsStr::new("--user"),
                 OsStr::new("swarm"),
                 OsStr::new("--password-file"),
@@ -124,6 +132,7 @@ fn a_host_with_the_password_joins_and_one_with_a_wrong_password_is_refused() {
     };
     member_joins_and_intruder_is_refused(
         &experiment,
+        &keys,
         daemon("member", &right),
         daemon("intruder", &wrong),
     );
@@ -176,12 +185,16 @@ fn mutual_tls_admits_a_host_certified_by_the_runs_authority_only() {
             r#"<hosts listen="{endpoint}" tls_certificate="world.pem" tls_private_key="world.key" tls_root_ca="ca.pem"><host name="member" /></hosts>"#
         ),
     );
+    let keys = TestKeys::new();
     let daemon = |name: &str, pem: &Path, key: &Path| {
+        let host_key = keys.key(name);
         HostDaemon::start_with(
             name,
             &endpoint,
             None,
             &[
+                OsStr::new("--key"),
+                host_key.as_os_str(),
                 OsStr::new("--tls-root-ca"),
                 ca_file.as_os_str(),
                 OsStr::new("--tls-certificate"),
@@ -193,6 +206,7 @@ fn mutual_tls_admits_a_host_certified_by_the_runs_authority_only() {
     };
     member_joins_and_intruder_is_refused(
         &experiment,
+        &keys,
         daemon("member", &member_pem, &member_key),
         daemon("intruder", &intruder_pem, &intruder_key),
     );

@@ -10,8 +10,8 @@ use std::time::Duration;
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
-    HostDaemon, Netns, assert_clean, bin_dir, follow_lines, free_port, shm_leftovers, swarm,
-    swarm_ctl, wait_for_line, workspace_root,
+    HostDaemon, Netns, TestKeys, assert_clean, bin_dir, follow_lines, free_port, shm_leftovers,
+    swarm, swarm_ctl, wait_for_line, workspace_root,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -27,10 +27,12 @@ struct Hosts {
     daemons: Vec<HostDaemon>,
     namespaces: Vec<Netns>,
     listen: Vec<String>,
+    keys: TestKeys,
 }
 
 impl Hosts {
     fn start(names: &[&str]) -> Hosts {
+        let keys = TestKeys::new();
         let namespaces: Result<Vec<Netns>, String> =
             names.iter().map(|_| Netns::create()).collect();
         match namespaces {
@@ -39,13 +41,14 @@ impl Hosts {
                 let mut daemons = Vec::new();
                 for (name, ns) in names.iter().zip(&namespaces) {
                     let endpoint = format!("tcp/{}:{}", ns.outer_ip, free_port(&ns.outer_ip));
-                    daemons.push(HostDaemon::start(name, &endpoint, Some(&ns.name)));
+                    daemons.push(HostDaemon::start(name, &endpoint, Some(&ns.name), &keys));
                     listen.push(endpoint);
                 }
                 Hosts {
                     daemons,
                     namespaces,
                     listen,
+                    keys,
                 }
             }
             Err(reason) => {
@@ -56,10 +59,11 @@ impl Hosts {
                 Hosts {
                     daemons: names
                         .iter()
-                        .map(|name| HostDaemon::start(name, &endpoint, None))
+                        .map(|name| HostDaemon::start(name, &endpoint, None, &keys))
                         .collect(),
                     namespaces: Vec::new(),
                     listen: vec![endpoint],
+                    keys,
                 }
             }
         }
@@ -72,6 +76,7 @@ impl Hosts {
         for endpoint in &self.listen {
             args.extend(["--listen".to_owned(), endpoint.clone()]);
         }
+        args.extend(self.keys.run_args());
         args
     }
 
@@ -80,7 +85,7 @@ impl Hosts {
         let name = self.daemons[i].name.clone();
         let endpoint = self.listen[i.min(self.listen.len() - 1)].clone();
         let ns = self.namespaces.get(i).map(|n| n.name.clone());
-        self.daemons[i] = HostDaemon::start(&name, &endpoint, ns.as_deref());
+        self.daemons[i] = HostDaemon::start(&name, &endpoint, ns.as_deref(), &self.keys);
     }
 
     /// Stops every daemon gracefully and checks it left no process and no shared memory.
@@ -137,7 +142,7 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
         outcome.stderr()
     );
 
-    let hosts = Hosts::start(&["alpha", "beta"]);
+    let mut hosts = Hosts::start(&["alpha", "beta"]);
     let multi = tempfile::tempdir().expect("a temporary directory");
     let out = multi.path().display().to_string();
     let host_args = hosts.run_args();
@@ -151,6 +156,15 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
         outcome.stderr()
     );
     assert_clean(&outcome);
+    for daemon in &mut hosts.daemons {
+        assert!(
+            daemon.wait_for("the world ended the run", EVENT_TIMEOUT)
+                && daemon.wait_for("share ended", EVENT_TIMEOUT),
+            "host {} kept its share after the run ended:\n{}",
+            daemon.name,
+            daemon.log()
+        );
+    }
 
     let multi_summary = summary(multi.path());
     assert_eq!(multi_summary["ticks"], 150);

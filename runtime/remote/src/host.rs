@@ -14,7 +14,8 @@
 //! or malformed message reach its agents (dropped and counted).
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::time::{Duration, Instant};
 
@@ -26,10 +27,11 @@ use zenoh::qos::CongestionControl;
 use zenoh::query::{Query, Queryable};
 use zenoh::sample::SampleKind;
 
+use super::auth::{Seal, answer_channel};
 use super::codec::{self, Header, Kind};
 use super::host_to_world::{AssignmentReply, OrderReply, Reply};
 use super::session::{ZenohOptions, zenoh_error};
-use super::world_to_host::{Assignment, Order, OrderAction};
+use super::world_to_host::{Assignment, Order, OrderAction, parse_kill};
 use super::{RemoteError, keys};
 use swarm_contract::messages::{SensorFrame, SupervisorSnapshot};
 use swarm_contract::process::binaries::Binaries;
@@ -45,6 +47,13 @@ const IDLE_PERIOD: Duration = Duration::from_millis(50);
 const LOG_LINES_QUOTED: usize = 8;
 /// How often a replacement agent's join is looked at.
 const REPLACEMENT_POLL: Duration = Duration::from_millis(5);
+/// Largest step between the ticks of two frames messages a share accepts: the world's ticks only grow, by one
+/// unless frames were lost on the way.
+const MAX_TICK_GAP: u64 = 1 << 20;
+/// How many (run, epoch) pairs the daemon remembers to refuse a replayed assignment.
+const SERVED_REMEMBERED: usize = 64;
+/// How long the daemon looks for the world's liveliness token before it takes a share.
+const WORLD_CHECK_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// What `swarm host` was asked to do.
 #[derive(Debug, Clone)]
@@ -61,6 +70,8 @@ pub struct HostOptions {
     pub max_payload: usize,
     /// Folder for the agents' logs (`robot-<id>.log`).
     pub logs: PathBuf,
+    /// How this host's messages are authenticated (its key, see [`crate::auth`]).
+    pub seal: Seal,
 }
 
 /// What reaches the daemon's loop from zenoh's callbacks.
@@ -73,8 +84,8 @@ enum Event {
     Frames { run: u64, bytes: Vec<u8> },
     /// The world of run `run` is gone.
     WorldGone { run: u64 },
-    /// The world of run `run` told the host to die.
-    Kill { run: u64 },
+    /// The world of run `run` told the host's share of epoch `epoch` to die.
+    Kill { run: u64, epoch: u32 },
 }
 
 /// Counters of dropped messages, logged when a share ends.
@@ -118,17 +129,18 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
         .wait()
         .map_err(zenoh_error("declaring the orders queryable"))?;
     let kill_sender = sender.clone();
+    let kill_seal = options.seal.clone();
+    let kill_key = keys::kill(&options.name);
     let _kill: Subscriber<()> = session
-        .declare_subscriber(keys::kill(&options.name))
+        .declare_subscriber(kill_key.clone())
         .callback(move |sample| {
             let bytes = sample.payload().to_bytes();
-            match <[u8; 8]>::try_from(bytes.as_ref()) {
-                Ok(run) => {
-                    let _ = kill_sender.send(Event::Kill {
-                        run: u64::from_le_bytes(run),
-                    });
+            match kill_seal.open(&kill_key, &bytes).map(parse_kill) {
+                Ok(Some((run, epoch))) => {
+                    let _ = kill_sender.send(Event::Kill { run, epoch });
                 }
-                Err(_) => tracing::warn!(len = bytes.len(), "ignoring a malformed kill message"),
+                Ok(None) => tracing::warn!(len = bytes.len(), "ignoring a malformed kill message"),
+                Err(e) => tracing::warn!("ignoring a kill message: {e}"),
             }
         })
         .wait()
@@ -145,6 +157,7 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
     );
 
     let mut share: Option<Share> = None;
+    let mut served: Vec<(u64, u32)> = Vec::new();
     while !stop.load(Ordering::Relaxed) {
         let event = match events.recv_timeout(IDLE_PERIOD) {
             Ok(event) => Some(event),
@@ -153,11 +166,24 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
         };
         match event {
             Some(Event::Assign(query)) => {
-                // A new assignment replaces the current share (the host rejoined after a loss).
-                drop(share.take());
-                share = accept(&session, options, &binaries, &query, &sender);
+                match authentic_assignment(&session, options, &query, &served) {
+                    Ok(assignment) => {
+                        // A new assignment replaces the current share (the host rejoined after a loss).
+                        drop(share.take());
+                        remember(&mut served, &assignment);
+                        share = accept(&session, options, &binaries, &query, assignment, &sender);
+                    }
+                    Err(Refusal::Silent(reason)) => {
+                        tracing::warn!("ignoring an assignment: {reason}");
+                    }
+                    Err(Refusal::Answered(reason)) => {
+                        tracing::warn!("refusing an assignment: {reason}");
+                        let refused = AssignmentReply::Refused { epoch: 0, reason };
+                        answer(&query, &options.seal, &refused, "the assignment");
+                    }
+                }
             }
-            Some(Event::Order(query)) => answer_order(&query, share.as_mut(), options.max_payload),
+            Some(Event::Order(query)) => answer_order(&query, share.as_mut(), options),
             Some(Event::Frames { run, bytes }) => {
                 if let Some(current) = share.as_mut().filter(|s| s.assignment.run == run) {
                     let newest = newest_frames(&events, &sender, run, bytes, &mut current.dropped);
@@ -173,8 +199,10 @@ pub fn serve(options: &HostOptions, stop: &AtomicBool) -> Result<(), RemoteError
                 tracing::info!(run = format!("{run:016x}"), "the world ended the run");
                 share = None;
             }
-            Some(Event::Kill { run })
-                if share.as_ref().is_some_and(|s| s.assignment.run == run) =>
+            Some(Event::Kill { run, epoch })
+                if share
+                    .as_ref()
+                    .is_some_and(|s| s.assignment.run == run && s.assignment.epoch == epoch) =>
             {
                 // As if the machine died: the share ends and the daemon exits without a goodbye.
                 tracing::error!(
@@ -247,68 +275,124 @@ fn newest_frames(
     newest
 }
 
-/// Answers an assignment query: starts the share, or refuses with the reason.
+/// Why an assignment is not taken: `Silent` when it may not be from the world (no answer, so a stranger learns
+/// nothing), `Answered` when the world sent it but it cannot be run.
+enum Refusal {
+    Silent(String),
+    Answered(String),
+}
+
+/// The assignment a query carries, if it is authentic (tagged with this host's key on its queryable), decodes,
+/// and is fresh: neither a (run, epoch) this daemon served already nor a run whose world is gone (a replay).
+fn authentic_assignment(
+    session: &Session,
+    options: &HostOptions,
+    query: &Query,
+    served: &[(u64, u32)],
+) -> Result<Assignment, Refusal> {
+    let bytes = query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
+    let payload = options
+        .seal
+        .open(&keys::assign(&options.name), &bytes)
+        .map_err(|e| Refusal::Silent(e.to_string()))?;
+    let assignment = codec::decode_message::<Assignment>(payload, options.max_payload)
+        .map_err(|e| Refusal::Answered(format!("malformed assignment: {e}")))?;
+    if assignment.name != options.name {
+        return Err(Refusal::Answered(format!(
+            "the assignment is for host '{}', this is '{}'",
+            assignment.name, options.name
+        )));
+    }
+    if served
+        .iter()
+        .any(|&(run, epoch)| run == assignment.run && epoch >= assignment.epoch)
+    {
+        return Err(Refusal::Silent(format!(
+            "run {:016x} epoch {} was served already (a replayed assignment)",
+            assignment.run, assignment.epoch
+        )));
+    }
+    let world_up = session
+        .liveliness()
+        .get(keys::world_token(assignment.run))
+        .timeout(WORLD_CHECK_TIMEOUT)
+        .wait()
+        .map_err(|e| Refusal::Silent(format!("looking for the run's world: {e}")))?
+        .recv()
+        .is_ok_and(|reply| reply.result().is_ok());
+    if !world_up {
+        return Err(Refusal::Silent(format!(
+            "the world of run {:016x} is not up (a replayed assignment?)",
+            assignment.run
+        )));
+    }
+    Ok(assignment)
+}
+
+/// Remembers a served (run, epoch), forgetting the oldest beyond [`SERVED_REMEMBERED`].
+fn remember(served: &mut Vec<(u64, u32)>, assignment: &Assignment) {
+    if served.len() >= SERVED_REMEMBERED {
+        served.remove(0);
+    }
+    served.push((assignment.run, assignment.epoch));
+}
+
+/// Answers `query` with `message`, tagged for the request it answers.
+fn answer<T: bincode::Encode>(query: &Query, seal: &Seal, message: &T, what: &str) {
+    let request = query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
+    let channel = answer_channel(query.key_expr().as_str(), &request);
+    match codec::encode_message(message) {
+        Ok(mut bytes) => {
+            seal.seal(&channel, &mut bytes);
+            if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {
+                tracing::warn!("answering {what}: {e}");
+            }
+        }
+        Err(e) => tracing::warn!("encoding the answer to {what}: {e}"),
+    }
+}
+
+/// Starts the share of an authentic assignment and answers the query: ready, or refused with the reason.
 fn accept(
     session: &Session,
     options: &HostOptions,
     binaries: &Binaries,
     query: &Query,
+    assignment: Assignment,
     sender: &Sender<Event>,
 ) -> Option<Share> {
-    let assignment = match query.payload() {
-        Some(payload) => {
-            codec::decode_message::<Assignment>(&payload.to_bytes(), options.max_payload)
-        }
-        None => Err(codec::WireError::Malformed(
-            "an assignment without payload".into(),
-        )),
-    };
-    let (reply, share) = match assignment {
+    let epoch = assignment.epoch;
+    let (reply, share) = match Share::start(session, options, binaries, assignment, sender) {
+        Ok(share) => (AssignmentReply::Ready { epoch }, Some(share)),
         Err(e) => {
-            tracing::warn!("ignoring a malformed assignment: {e}");
-            (
-                AssignmentReply::Refused {
-                    epoch: 0,
-                    reason: format!("malformed assignment: {e}"),
-                },
-                None,
-            )
-        }
-        Ok(assignment) => {
-            let epoch = assignment.epoch;
-            match Share::start(session, options, binaries, assignment, sender) {
-                Ok(share) => (AssignmentReply::Ready { epoch }, Some(share)),
-                Err(e) => {
-                    tracing::error!("refusing the share: {e}");
-                    (
-                        AssignmentReply::Refused {
-                            epoch,
-                            reason: e.to_string(),
-                        },
-                        None,
-                    )
-                }
-            }
+            tracing::error!("refusing the share: {e}");
+            let reason = e.to_string();
+            (AssignmentReply::Refused { epoch, reason }, None)
         }
     };
-    match codec::encode_message(&reply) {
-        Ok(bytes) => {
-            if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {
-                tracing::warn!("answering the assignment: {e}");
-            }
-        }
-        Err(e) => tracing::warn!("encoding the assignment reply: {e}"),
-    }
+    answer(query, &options.seal, &reply, "the assignment");
     share
 }
 
-/// Answers a fault order: carried out by the current share if the order is for it, refused otherwise.
-fn answer_order(query: &Query, share: Option<&mut Share>, max_payload: usize) {
-    let order = match query.payload() {
-        Some(payload) => codec::decode_message::<Order>(&payload.to_bytes(), max_payload),
-        None => Err(codec::WireError::Malformed(
-            "an order without payload".into(),
-        )),
+/// Answers a fault order: carried out by the current share if the order is authentic, for it, and newer than
+/// every order it carried out (a replayed order is refused); refused otherwise.
+fn answer_order(query: &Query, share: Option<&mut Share>, options: &HostOptions) {
+    let bytes = query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
+    let order = match options.seal.open(&keys::orders(&options.name), &bytes) {
+        Ok(payload) => codec::decode_message::<Order>(payload, options.max_payload),
+        Err(e) => {
+            tracing::warn!("ignoring an order: {e}");
+            return;
+        }
     };
     let reply = match (order, share) {
         (Err(e), _) => {
@@ -318,8 +402,11 @@ fn answer_order(query: &Query, share: Option<&mut Share>, max_payload: usize) {
             }
         }
         (Ok(order), Some(share))
-            if order.run == share.assignment.run && order.epoch == share.assignment.epoch =>
+            if order.run == share.assignment.run
+                && order.epoch == share.assignment.epoch
+                && order.number > share.last_order =>
         {
+            share.last_order = order.number;
             match share.carry_out(order.robot, order.action) {
                 Ok(()) => OrderReply::Done,
                 Err(reason) => {
@@ -330,19 +417,12 @@ fn answer_order(query: &Query, share: Option<&mut Share>, max_payload: usize) {
         }
         (Ok(order), _) => OrderReply::Failed {
             reason: format!(
-                "no share of run {:016x} epoch {} on this host",
-                order.run, order.epoch
+                "no share of run {:016x} epoch {} on this host, or order {} is not newer than the last one",
+                order.run, order.epoch, order.number
             ),
         },
     };
-    match codec::encode_message(&reply) {
-        Ok(bytes) => {
-            if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {
-                tracing::warn!("answering an order: {e}");
-            }
-        }
-        Err(e) => tracing::warn!("encoding an order's answer: {e}"),
-    }
+    answer(query, &options.seal, &reply, "an order");
 }
 
 /// One run's share on this host.
@@ -361,6 +441,13 @@ struct Share {
     replies: Vec<Reply>,
     buf: Vec<u8>,
     last_tick: u64,
+    /// Number of the last fault order carried out (orders are numbered by the world, growing).
+    last_order: u64,
+    /// How the share's messages are authenticated, and the channel its replies are tagged for.
+    seal: Seal,
+    replies_key: String,
+    /// Frames messages dropped because they were not from the world (counted by zenoh's callback).
+    unauthenticated: Arc<AtomicU64>,
     /// Whether a tick ran in which the share's live robots all answered (a rejoined share's robots are dead for
     /// the world at first).
     took_part: bool,
@@ -411,18 +498,34 @@ impl Share {
         link_config.pin_chains = assignment.pin_agents;
         link_config.realtime = priority::tick_at_realtime(assignment.realtime_priority);
         let link = WorldLink::create(&spec, link_config)?;
+        let replies_key = keys::replies(run, &options.name);
         let publisher = session
-            .declare_publisher(keys::replies(run, &options.name))
-            .congestion_control(CongestionControl::Block)
+            .declare_publisher(replies_key.clone())
+            // The world never waits on a stalled link: a dropped batch is a missed tick.
+            .congestion_control(CongestionControl::Drop)
             .express(true)
             .wait()
             .map_err(zenoh_error("declaring the replies publisher"))?;
         let frames_sender = sender.clone();
+        let frames_key = keys::frames(run, &options.name);
+        let frames_seal = options.seal.clone();
+        let unauthenticated = Arc::new(AtomicU64::new(0));
+        let frames_rejected = Arc::clone(&unauthenticated);
         let frames = session
-            .declare_subscriber(keys::frames(run, &options.name))
+            .declare_subscriber(frames_key.clone())
             .callback(move |sample| {
-                let bytes = sample.payload().to_bytes().into_owned();
-                let _ = frames_sender.send(Event::Frames { run, bytes });
+                // Checked here, so a message not from the world never reaches the daemon's queue.
+                let bytes = sample.payload().to_bytes();
+                match frames_seal.open(&frames_key, &bytes) {
+                    Ok(payload) => {
+                        let bytes = payload.to_vec();
+                        let _ = frames_sender.send(Event::Frames { run, bytes });
+                    }
+                    Err(e) => {
+                        frames_rejected.fetch_add(1, Ordering::Relaxed);
+                        tracing::debug!("dropping a frames message: {e}");
+                    }
+                }
             })
             .wait()
             .map_err(zenoh_error("subscribing to the frames"))?;
@@ -430,6 +533,8 @@ impl Share {
         let world = session
             .liveliness()
             .declare_subscriber(keys::world_token(run))
+            // With history the subscriber learns of the world's token, so zenoh also tells it when the token goes.
+            .history(true)
             .callback(move |sample| {
                 if sample.kind() == SampleKind::Delete {
                     let _ = world_sender.send(Event::WorldGone { run });
@@ -445,6 +550,10 @@ impl Share {
             replies: vec![Reply::Missing; count as usize],
             buf: Vec::new(),
             last_tick: 0,
+            last_order: 0,
+            seal: options.seal.clone(),
+            replies_key,
+            unauthenticated,
             took_part: false,
             dropped: Dropped::default(),
             spec,
@@ -692,9 +801,11 @@ impl Share {
                 return Ok(());
             }
         };
-        if header.epoch != self.assignment.epoch
+        if header.run != self.assignment.run
+            || header.epoch != self.assignment.epoch
             || header.host != self.assignment.host
             || header.tick <= self.last_tick
+            || (self.last_tick > 0 && header.tick - self.last_tick > MAX_TICK_GAP)
         {
             self.dropped.stale += 1;
             tracing::trace!(tick = header.tick, "dropping a stale frames message");
@@ -739,6 +850,7 @@ impl Share {
             header.tick,
         );
         codec::encode_batch(&mut self.buf, &out, &self.robots, &self.replies)?;
+        self.seal.seal(&self.replies_key, &mut self.buf);
         self.publisher
             .put(self.buf.clone())
             .wait()
@@ -762,6 +874,7 @@ impl Drop for Share {
             last_tick = self.last_tick,
             stale = self.dropped.stale,
             malformed = self.dropped.malformed,
+            unauthenticated = self.unauthenticated.load(Ordering::Relaxed),
             "share ended"
         );
     }

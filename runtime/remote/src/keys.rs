@@ -3,7 +3,7 @@
 //! - `swarm/hosts/<host>`: a host daemon's liveliness token (it is up and reachable).
 //! - `swarm/hosts/<host>/assign`: the host's queryable; the world sends it its share of a run.
 //! - `swarm/hosts/<host>/orders`: the host's queryable for fault orders on its robots' agents.
-//! - `swarm/hosts/<host>/kill`: `swarm ctl kill-host`; the payload names the run (8 bytes, little-endian).
+//! - `swarm/hosts/<host>/kill`: `swarm ctl kill-host`; the payload names the run and the share's epoch.
 //! - `swarm/runs/<run>/world`: the world's liveliness token while the run lasts (hosts end their share when it goes).
 //! - `swarm/runs/<run>/frames/<host>` and `swarm/runs/<run>/replies/<host>`: one message per host per tick each way.
 

@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod auth;
 pub mod codec;
 pub mod host;
 pub mod host_to_world;
@@ -59,6 +60,14 @@ pub enum RemoteError {
         /// The run.
         run: u64,
     },
+    /// Authentication is on and a host of the placement has no key.
+    #[error(
+        "host '{0}' has no key (create it with `swarm host-key {0}`, or run with --insecure-hosts)"
+    )]
+    NoKey(String),
+    /// A host key cannot be read or created.
+    #[error(transparent)]
+    Key(#[from] auth::KeyError),
     /// Hosts did not join in time.
     #[error("{0}")]
     HostsMissing(String),

@@ -10,6 +10,7 @@ use std::time::Duration;
 
 use clap::Args;
 
+use crate::auth::HostKeys;
 use crate::session::{DEFAULT_LEASE, DEFAULT_LISTEN, ZenohOptions};
 use crate::world_bridge::HostShare;
 use swarm_contract::config::hosts::TlsFileError;
@@ -26,6 +27,14 @@ pub struct HostsArgs {
     /// <hosts listen>; default tcp/127.0.0.1:7447).
     #[arg(long = "listen")]
     pub listen: Vec<String>,
+    /// Folder of the hosts' keys, one `<name>.key` per host (overrides <hosts keys>; default
+    /// ~/.config/swarm/keys). A missing key is created there; give it to its host (`swarm host --key`).
+    #[arg(long = "keys", value_name = "DIR")]
+    pub keys: Option<PathBuf>,
+    /// Turn host authentication off: anyone who can reach the world's endpoint can then join, listen in and
+    /// command robots. Only for a network you trust (the same as <hosts insecure="true">).
+    #[arg(long = "insecure-hosts", conflicts_with = "keys")]
+    pub insecure_hosts: bool,
 }
 
 impl HostsArgs {
@@ -37,6 +46,12 @@ impl HostsArgs {
         }
         for endpoint in &self.listen {
             args.extend(["--listen".into(), endpoint.clone()]);
+        }
+        if let Some(dir) = &self.keys {
+            args.extend(["--keys".into(), dir.display().to_string()]);
+        }
+        if self.insecure_hosts {
+            args.push("--insecure-hosts".into());
         }
         args
     }
@@ -65,6 +80,15 @@ pub enum HostsError {
     /// A TLS file cannot be read.
     #[error("{0}")]
     TlsFile(#[from] TlsFileError),
+    /// Authentication is on and there is no key folder.
+    #[error(
+        "no folder for the hosts' keys: pass --keys DIR (or <hosts keys=\"DIR\">), set HOME, or turn \
+         authentication off with --insecure-hosts on a trusted network"
+    )]
+    NoKeyFolder,
+    /// A key cannot be read or created.
+    #[error(transparent)]
+    Key(#[from] crate::auth::KeyError),
     /// The world is to listen on a `tls/...` endpoint without a certificate.
     #[error(
         "the world listens on {endpoint}, which needs the experiment's <hosts tls_certificate=\"…\" tls_private_key=\"…\">"
@@ -84,6 +108,15 @@ pub struct WeightedHost {
     pub weight: u32,
 }
 
+/// How the hosts of a run prove who they are.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Authentication {
+    /// Each host has a key in this folder (`<name>.key`), see [`crate::auth`].
+    Keys(PathBuf),
+    /// Off: anyone who reaches the endpoint can speak.
+    Off,
+}
+
 /// The hosts of a run and how to reach them.
 #[derive(Debug, Clone)]
 pub struct HostsPlan {
@@ -93,6 +126,8 @@ pub struct HostsPlan {
     pub listen: Vec<String>,
     /// Session settings.
     pub zenoh: ZenohOptions,
+    /// How hosts are authenticated.
+    pub authentication: Authentication,
 }
 
 /// Parses `NAME[:WEIGHT],...`.
@@ -183,11 +218,48 @@ impl HostsPlan {
             });
         }
         zenoh.tls.check_readable()?;
+        let insecure = args.insecure_hosts || element.is_some_and(|e| e.insecure);
+        let authentication = if insecure {
+            Authentication::Off
+        } else {
+            let dir = args
+                .keys
+                .clone()
+                .or_else(|| element.and_then(|e| e.keys.clone()))
+                .or_else(crate::auth::default_key_dir)
+                .ok_or(HostsError::NoKeyFolder)?;
+            Authentication::Keys(dir)
+        };
         Ok(Some(HostsPlan {
             hosts,
             listen,
             zenoh,
+            authentication,
         }))
+    }
+
+    /// Creates the keys of the plan's hosts that do not exist yet (the launcher does, before the world starts);
+    /// returns the files created, which the operator hands to their hosts.
+    pub fn create_missing_keys(&self) -> Result<Vec<PathBuf>, HostsError> {
+        match &self.authentication {
+            Authentication::Keys(dir) => Ok(crate::auth::create_missing_keys(
+                dir,
+                self.hosts.iter().map(|h| h.name.as_str()),
+            )?),
+            Authentication::Off => Ok(Vec::new()),
+        }
+    }
+
+    /// Reads the hosts' keys for the world, and has its session admit exactly those hosts.
+    pub fn load_keys(&mut self) -> Result<HostKeys, HostsError> {
+        let keys = match &self.authentication {
+            Authentication::Keys(dir) => {
+                HostKeys::load(dir, self.hosts.iter().map(|h| h.name.as_str()))?
+            }
+            Authentication::Off => HostKeys::Off,
+        };
+        self.zenoh.admitted = keys.admitted();
+        Ok(keys)
     }
 
     /// Shares `robots` robots among the hosts in proportion to their weights (largest remainder, ties to the
@@ -315,6 +387,7 @@ mod tests {
         let args = HostsArgs {
             hosts: Some("b:2,c".into()),
             listen: vec!["tcp/127.0.0.1:9000".into()],
+            ..HostsArgs::default()
         };
         let plan = HostsPlan::resolve(config.as_ref(), &args)
             .expect("valid")
@@ -348,6 +421,7 @@ mod tests {
         let args = HostsArgs {
             hosts: None,
             listen: vec!["tls/127.0.0.1:9000".into()],
+            ..HostsArgs::default()
         };
         let err = HostsPlan::resolve(plain.as_ref(), &args)
             .expect_err("no certificate")

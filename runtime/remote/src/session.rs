@@ -18,6 +18,8 @@ use super::RemoteError;
 
 /// Default link lease: a frozen or cut-off host is noticed after about this long.
 pub const DEFAULT_LEASE: Duration = Duration::from_secs(1);
+/// Largest credentials file read.
+const MAX_CREDENTIALS_BYTES: u64 = 1 << 20;
 /// Default endpoint the world listens on (loopback only).
 pub const DEFAULT_LISTEN: &str = "tcp/127.0.0.1:7447";
 
@@ -34,6 +36,9 @@ pub struct ZenohOptions {
     pub password: Option<String>,
     /// File of `user:password` lines the listening side accepts (zenoh's `dictionary_file`).
     pub credentials_file: Option<PathBuf>,
+    /// More `(user, password)` pairs the listening side accepts: the hosts' admission passwords
+    /// ([`crate::auth`]).
+    pub admitted: Vec<(String, String)>,
     /// Certificates for `tls/...` endpoints.
     pub tls: TlsFiles,
 }
@@ -46,6 +51,7 @@ impl Default for ZenohOptions {
             user: None,
             password: None,
             credentials_file: None,
+            admitted: Vec::new(),
             tls: TlsFiles::default(),
         }
     }
@@ -163,12 +169,51 @@ impl ZenohOptions {
     /// The world's session: peer mode, listening on `listen` (e.g. `tcp/127.0.0.1:7447`).
     pub fn open_world(&self, listen: &[String]) -> Result<Session, RemoteError> {
         let mut config = self.config("peer", TlsSide::Listen)?;
+        // zenoh reads its accepted users from a file when the session opens: the hosts' admission passwords go
+        // into a private temporary file (with the operator's own credentials file, if any), removed once open.
+        let _dictionary = match self.admitted.is_empty() {
+            true => None,
+            false => {
+                let file = self.write_dictionary()?;
+                set(
+                    &mut config,
+                    "transport/auth/usrpwd/dictionary_file",
+                    &json_path(file.path()),
+                )?;
+                Some(file)
+            }
+        };
         let endpoints = serde_json::to_string(listen).unwrap_or_else(|_| "[]".into());
         set(&mut config, "listen/endpoints", &endpoints)?;
         set(&mut config, "connect/endpoints", "[]")?;
         zenoh::open(config).wait().map_err(zenoh_error(format!(
             "opening the world's session on {endpoints}"
         )))
+    }
+
+    /// The accepted `user:password` lines, the credentials file's first, in a file only this user can read.
+    fn write_dictionary(&self) -> Result<tempfile::NamedTempFile, RemoteError> {
+        let io = |what: String| move |source| RemoteError::Io { what, source };
+        let mut text = match &self.credentials_file {
+            Some(path) => swarm_contract::config::input::read_text(path, MAX_CREDENTIALS_BYTES)
+                .map_err(|e| RemoteError::Io {
+                    what: "reading the credentials file".into(),
+                    source: std::io::Error::other(e.to_string()),
+                })?,
+            None => String::new(),
+        };
+        if !text.is_empty() && !text.ends_with('\n') {
+            text.push('\n');
+        }
+        for (user, password) in &self.admitted {
+            text.push_str(&format!("{user}:{password}\n"));
+        }
+        // NamedTempFile creates its file readable by its owner only.
+        let mut file = tempfile::NamedTempFile::new()
+            .map_err(io("creating the hosts' admission file".into()))?;
+        std::io::Write::write_all(&mut file, text.as_bytes())
+            .map_err(io("writing the hosts' admission file".into()))?;
+        Ok(file)
     }
 
     /// A host's session: client mode, connected to `endpoint` (retried until it answers).

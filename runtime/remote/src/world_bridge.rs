@@ -13,7 +13,10 @@
 //! It must never stall: every wait is bounded by the tick deadline, and a malformed, oversized or stale payload is
 //! dropped and counted.
 
+use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::time::{Duration, Instant};
 
@@ -23,10 +26,11 @@ use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
 use zenoh::{Session, Wait};
 
+use super::auth::{HostKeys, Seal, answer_channel};
 use super::codec::{self, Header, Kind};
 use super::host_to_world::{AssignmentReply, OrderReply, Reply};
 use super::session::{ZenohOptions, zenoh_error};
-use super::world_to_host::{Assignment, Order, OrderAction};
+use super::world_to_host::{Assignment, Order, OrderAction, kill_payload};
 use super::{RemoteError, keys};
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::transport::{CommandStatus, TickOutcome};
@@ -76,6 +80,8 @@ pub struct RemoteOptions {
     pub compiled_supervisors: Vec<(String, Vec<u8>)>,
     /// The run's `--limit` overrides, handed to every host for its agents.
     pub limits: Vec<String>,
+    /// The hosts' keys: every message to and from a host is authenticated with its key ([`crate::auth`]).
+    pub keys: HostKeys,
 }
 
 /// What happened to a host during the run.
@@ -111,6 +117,8 @@ pub struct Dropped {
     pub stale: u64,
     /// Messages that did not decode, were oversized, or named robots their host does not own.
     pub rejected: u64,
+    /// Messages whose tag did not match their host's key (not from that host).
+    pub unauthenticated: u64,
 }
 
 /// What reaches the world from zenoh's callbacks.
@@ -165,6 +173,9 @@ struct Host {
     returning: bool,
     replies: Vec<Reply>,
     publisher: Publisher<'static>,
+    /// How the host's messages are authenticated, and the channel its frames are tagged for.
+    seal: Seal,
+    frames_key: String,
     events: Vec<HostEvent>,
 }
 
@@ -195,6 +206,8 @@ pub struct RemoteHosts {
     answer: Option<Result<Vec<u8>, String>>,
     buf: Vec<u8>,
     dropped: Dropped,
+    /// Messages dropped in zenoh's callbacks because their tag did not match (they never reach `incoming`).
+    unauthenticated: Arc<AtomicU64>,
     _token: LivelinessToken,
     _replies: Subscriber<()>,
     _hosts: Subscriber<()>,
@@ -208,18 +221,38 @@ impl RemoteHosts {
         robots: u32,
         run: u64,
     ) -> Result<RemoteHosts, RemoteError> {
+        let mut seals = HashMap::new();
         for host in &options.hosts {
             swarm_contract::config::hosts::check_host_name(&host.name)?;
+            let seal = options
+                .keys
+                .seal(&host.name)
+                .ok_or_else(|| RemoteError::NoKey(host.name.clone()))?;
+            seals.insert(keys::replies(run, &host.name), (host.name.clone(), seal));
         }
         let session = options.zenoh.open_world(&options.listen)?;
         let (sender, incoming) = mpsc::channel();
         let replies_sender = sender.clone();
+        let unauthenticated = Arc::new(AtomicU64::new(0));
+        let replies_rejected = Arc::clone(&unauthenticated);
         let replies = session
             .declare_subscriber(keys::all_replies(run))
             .callback(move |sample| {
-                if let Some(host) = keys::host_of_replies(sample.key_expr().as_str()) {
-                    let bytes = sample.payload().to_bytes().into_owned();
-                    let _ = replies_sender.send(Incoming::Replies(host.to_owned(), bytes));
+                // Checked here, so a batch its host did not send never reaches the world's queue.
+                let key = sample.key_expr().as_str();
+                let Some((host, seal)) = seals.get(key) else {
+                    replies_rejected.fetch_add(1, Ordering::Relaxed);
+                    return;
+                };
+                match seal.open(key, &sample.payload().to_bytes()) {
+                    Ok(payload) => {
+                        let bytes = payload.to_vec();
+                        let _ = replies_sender.send(Incoming::Replies(host.clone(), bytes));
+                    }
+                    Err(e) => {
+                        replies_rejected.fetch_add(1, Ordering::Relaxed);
+                        tracing::debug!(host, "dropping replies: {e}");
+                    }
                 }
             })
             .wait()
@@ -247,8 +280,9 @@ impl RemoteHosts {
             .map_err(zenoh_error("declaring the world's liveliness token"))?;
         let mut hosts = Vec::with_capacity(options.hosts.len());
         for share in &options.hosts {
+            let frames_key = keys::frames(run, &share.name);
             let publisher = session
-                .declare_publisher(keys::frames(run, &share.name))
+                .declare_publisher(frames_key.clone())
                 // A stalled link must never block the world: a dropped batch is a missed tick for that host.
                 .congestion_control(CongestionControl::Drop)
                 .express(true)
@@ -264,6 +298,8 @@ impl RemoteHosts {
                 live_from: 1,
                 returning: false,
                 publisher,
+                seal: options.keys.seal(&share.name).unwrap_or(Seal::Off),
+                frames_key,
                 events: Vec::new(),
             });
         }
@@ -296,6 +332,7 @@ impl RemoteHosts {
             answer: None,
             buf: Vec::new(),
             dropped: Dropped::default(),
+            unauthenticated,
             _token: token,
             _replies: replies,
             _hosts: hosts_watch,
@@ -309,11 +346,11 @@ impl RemoteHosts {
             return Ok(());
         };
         tracing::warn!(host = host.share.name, "killing the host as asked");
+        let key = keys::kill(&host.share.name);
+        let mut payload = kill_payload(self.run, host.epoch);
+        host.seal.seal(&key, &mut payload);
         self.session
-            .put(
-                keys::kill(&host.share.name),
-                self.run.to_le_bytes().to_vec(),
-            )
+            .put(key, payload)
             .wait()
             .map_err(zenoh_error("telling a host to die"))
     }
@@ -399,6 +436,7 @@ impl RemoteHosts {
             let header = Header::new(Kind::Frames, self.run, index as u16, host.epoch, tick);
             let frames = host.share.robots.iter().map(|&r| &self.frames[r as usize]);
             codec::encode_batch(&mut self.buf, &header, &host.share.robots, frames)?;
+            host.seal.seal(&host.frames_key, &mut self.buf);
             host.publisher
                 .put(self.buf.clone())
                 .wait()
@@ -575,18 +613,21 @@ impl RemoteHosts {
                 Vec::new()
             },
         };
-        let payload = codec::encode_message(&assignment)?;
+        let key = keys::assign(&host.share.name);
+        let mut payload = codec::encode_message(&assignment)?;
+        host.seal.seal(&key, &mut payload);
         tracing::info!(
             host = host.share.name,
             epoch = host.epoch,
             robots = host.share.robots.len(),
             "assigning"
         );
-        let key = keys::assign(&host.share.name);
         let ended = Incoming::AssignEnded(index, host.epoch);
+        let seal = host.seal.clone();
         self.query(
             key,
             payload,
+            seal,
             self.options.join_timeout + Duration::from_secs(5),
             move |answer| Incoming::Assigned(index, answer),
             ended,
@@ -595,11 +636,13 @@ impl RemoteHosts {
     }
 
     /// Sends a query whose answer arrives as the event `answered` makes of it, followed by `ended` when the
-    /// query is finished (answered or not).
+    /// query is finished (answered or not). An answer not tagged for this request with `seal` counts as
+    /// unauthenticated and is dropped.
     fn query(
         &self,
         key: String,
         payload: Vec<u8>,
+        seal: Seal,
         timeout: Duration,
         answered: impl Fn(Result<Vec<u8>, String>) -> Incoming + Send + Sync + 'static,
         ended: Incoming,
@@ -609,14 +652,25 @@ impl RemoteHosts {
             sender: self.sender.clone(),
             ended: Some(ended),
         };
+        let channel = answer_channel(&key, &payload);
+        let unauthenticated = Arc::clone(&self.unauthenticated);
         self.session
             .get(key)
             .payload(payload)
             .timeout(timeout)
+            // A host that stopped reading must not block the world: an unsent query goes unanswered.
+            .congestion_control(CongestionControl::Drop)
             .callback(move |reply| {
                 let _ = &ended;
                 let answer = match reply.result() {
-                    Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
+                    Ok(sample) => match seal.open(&channel, &sample.payload().to_bytes()) {
+                        Ok(payload) => Ok(payload.to_vec()),
+                        Err(e) => {
+                            unauthenticated.fetch_add(1, Ordering::Relaxed);
+                            tracing::debug!("dropping an answer: {e}");
+                            return;
+                        }
+                    },
                     Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
                 };
                 let _ = sender.send(answered(answer));
@@ -794,19 +848,24 @@ impl RemoteHosts {
             OrderAction::Respawn { .. } => self.options.join_timeout + Duration::from_secs(5),
             _ => self.options.tick_deadline.max(Duration::from_secs(5)),
         };
+        self.orders_sent += 1;
+        let number = self.orders_sent;
         let order = Order {
             run: self.run,
             epoch,
+            number,
             robot,
             action: action.clone(),
         };
-        let payload = codec::encode_message(&order)?;
-        self.orders_sent += 1;
+        let key = keys::orders(&name);
+        let mut payload = codec::encode_message(&order)?;
+        let seal = self.hosts[index].seal.clone();
+        seal.seal(&key, &mut payload);
         self.answer = None;
-        let number = self.orders_sent;
         self.query(
-            keys::orders(&name),
+            key,
             payload,
+            seal,
             timeout,
             move |answer| Incoming::Ordered(number, answer),
             Incoming::OrderEnded(number),
@@ -869,7 +928,10 @@ impl RemoteHosts {
 
     /// Payloads dropped so far.
     pub fn dropped(&self) -> Dropped {
-        self.dropped
+        Dropped {
+            unauthenticated: self.unauthenticated.load(Ordering::Relaxed),
+            ..self.dropped
+        }
     }
 }
 
@@ -881,6 +943,7 @@ mod tests {
     use std::sync::atomic::{AtomicBool, Ordering};
 
     use super::*;
+    use crate::auth::HostKey;
 
     /// How a fake host answers frames.
     #[derive(Clone, Copy)]
@@ -891,6 +954,18 @@ mod tests {
         Impostor(u32),
         /// Sends bytes that are not a batch.
         Garbage,
+        /// Answers honestly, and also sends replies on another host's key for that host's robot, tagged with its
+        /// own key (one host speaking for another).
+        Forger { victim: &'static str, robot: u32 },
+    }
+
+    /// The test's key of host `name` (made of its name, so every test agrees).
+    fn key_of(name: &str) -> Arc<HostKey> {
+        let mut secret = [0u8; crate::auth::KEY_LEN];
+        for (byte, b) in secret.iter_mut().zip(name.bytes().cycle()) {
+            *byte = b;
+        }
+        Arc::new(HostKey::from_secret(&secret))
     }
 
     /// A host played by the test: answers its assignment, then every frames message, until dropped.
@@ -906,6 +981,7 @@ mod tests {
                 .open_host(endpoint)
                 .expect("the fake host connects");
             let stop = Arc::new(AtomicBool::new(false));
+            let seal = Seal::Key(key_of(name));
             let queryable = session
                 .declare_queryable(keys::assign(name))
                 .wait()
@@ -915,6 +991,7 @@ mod tests {
             let declaring = session.clone();
             let token_key = keys::host_token(name);
             let name = name.to_owned();
+            let assign_seal = seal.clone();
             let assign = std::thread::spawn(move || {
                 while !flag.load(Ordering::Relaxed) {
                     let Ok(Some(query)) = queryable.recv_timeout(Duration::from_millis(20)) else {
@@ -924,8 +1001,11 @@ mod tests {
                         .payload()
                         .map(|p| p.to_bytes().into_owned())
                         .unwrap_or_default();
+                    let payload = assign_seal
+                        .open(&keys::assign(&name), &bytes)
+                        .expect("the world's key");
                     let assignment: Assignment =
-                        codec::decode_message(&bytes, codec::DEFAULT_MAX_PAYLOAD)
+                        codec::decode_message(payload, codec::DEFAULT_MAX_PAYLOAD)
                             .expect("an assignment");
                     // Like a real host: ready to receive frames before saying so.
                     let frames = declaring
@@ -936,12 +1016,25 @@ mod tests {
                         .declare_publisher(keys::replies(assignment.run, &name))
                         .wait()
                         .expect("publisher");
+                    let forged = match behaviour {
+                        Behaviour::Forger { victim, .. } => Some(
+                            declaring
+                                .declare_publisher(keys::replies(assignment.run, victim))
+                                .wait()
+                                .expect("publisher"),
+                        ),
+                        _ => None,
+                    };
                     let robots: Vec<u32> = assignment.robots.iter().map(|(r, _)| *r).collect();
-                    let _ = share_tx.send((robots, frames, publisher));
-                    let reply = codec::encode_message(&AssignmentReply::Ready {
+                    let _ = share_tx.send((robots, frames, publisher, forged));
+                    let mut reply = codec::encode_message(&AssignmentReply::Ready {
                         epoch: assignment.epoch,
                     })
                     .expect("encodes");
+                    assign_seal.seal(
+                        &answer_channel(query.key_expr().as_str(), &bytes),
+                        &mut reply,
+                    );
                     query
                         .reply(query.key_expr().clone(), reply)
                         .wait()
@@ -957,7 +1050,7 @@ mod tests {
             let answer = std::thread::spawn(move || {
                 let _token = token;
                 // The world assigns the share once it sees the token, i.e. once the test waits for the hosts.
-                let Ok((robots, frames, publisher)) = share_rx.recv() else {
+                let Ok((robots, frames, publisher, forged)) = share_rx.recv() else {
                     return;
                 };
                 let mut out = vec![SensorFrame::empty(0); robots.len()];
@@ -967,8 +1060,10 @@ mod tests {
                         continue;
                     };
                     let bytes = sample.payload().to_bytes();
+                    let frames_key = sample.key_expr().as_str();
+                    let bytes = seal.open(frames_key, &bytes).expect("the world's key");
                     let header =
-                        codec::decode_batch(&bytes, Kind::Frames, &robots, &mut out, 1 << 20)
+                        codec::decode_batch(bytes, Kind::Frames, &robots, &mut out, 1 << 20)
                             .expect("frames decode");
                     let reply_header = Header::new(
                         Kind::Replies,
@@ -994,7 +1089,22 @@ mod tests {
                     if let Behaviour::Garbage = behaviour {
                         buf = b"not a batch".to_vec();
                     }
+                    seal.seal(publisher.key_expr().as_str(), &mut buf);
                     publisher.put(buf.clone()).wait().expect("put");
+                    if let (Behaviour::Forger { robot, .. }, Some(forged)) = (behaviour, &forged) {
+                        let mut command = ActuatorCommand::idle(robot, header.tick);
+                        command.wheels = [9.0, 9.0];
+                        let header = Header::new(Kind::Replies, header.run, 0, 1, header.tick);
+                        codec::encode_batch(
+                            &mut buf,
+                            &header,
+                            &[robot],
+                            &[Reply::Answered(command)],
+                        )
+                        .expect("encodes");
+                        seal.seal(forged.key_expr().as_str(), &mut buf);
+                        forged.put(buf.clone()).wait().expect("put");
+                    }
                 }
             });
             FakeHost {
@@ -1041,6 +1151,12 @@ mod tests {
             max_payload: codec::DEFAULT_MAX_PAYLOAD,
             compiled_supervisors: Vec::new(),
             limits: Vec::new(),
+            keys: HostKeys::On(
+                shares
+                    .iter()
+                    .map(|(name, _)| ((*name).to_owned(), key_of(name)))
+                    .collect(),
+            ),
         };
         RemoteHosts::start(options, robots, 0x5eed).expect("the world listens")
     }
@@ -1071,6 +1187,37 @@ mod tests {
             "the impostor's batch must not command robot 2"
         );
         assert!(world.dropped().rejected >= 1);
+    }
+
+    #[test]
+    fn replies_tagged_with_another_hosts_key_are_never_taken() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("victim", &[0]), ("forger", &[1])]);
+        let _victim = FakeHost::start(&endpoint, "victim", Behaviour::Honest);
+        let _forger = FakeHost::start(
+            &endpoint,
+            "forger",
+            Behaviour::Forger {
+                victim: "victim",
+                robot: 0,
+            },
+        );
+        world
+            .wait_for_hosts(Duration::from_secs(30))
+            .expect("both hosts join");
+        for _ in 0..20 {
+            world.tick_with(|_, _, _| {}).expect("a tick");
+            assert_ne!(
+                world.command(0).map(|c| c.wheels),
+                Some([9.0, 9.0]),
+                "the forger commanded the victim's robot"
+            );
+        }
+        assert!(
+            world.dropped().unauthenticated >= 1,
+            "{:?}",
+            world.dropped()
+        );
     }
 
     #[test]

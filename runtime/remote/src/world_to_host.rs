@@ -72,6 +72,8 @@ pub struct Order {
     pub run: u64,
     /// The host's assignment epoch the order belongs to.
     pub epoch: u32,
+    /// The world's number for the order; it grows with every order of the run, so a host refuses a replayed one.
+    pub number: u64,
     /// Run-wide robot id (a robot of the host's share).
     pub robot: u32,
     /// What to do.
@@ -115,6 +117,20 @@ impl OrderAction {
     }
 }
 
+/// The payload of `swarm ctl kill-host` for the share of `run` in `epoch`: run then epoch, little-endian.
+pub fn kill_payload(run: u64, epoch: u32) -> Vec<u8> {
+    let mut bytes = run.to_le_bytes().to_vec();
+    bytes.extend_from_slice(&epoch.to_le_bytes());
+    bytes
+}
+
+/// The run and epoch of a [`kill_payload`]; `None` for any other length.
+pub fn parse_kill(bytes: &[u8]) -> Option<(u64, u32)> {
+    let run = u64::from_le_bytes(bytes.get(..8)?.try_into().ok()?);
+    let epoch = u32::from_le_bytes(bytes.get(8..)?.try_into().ok()?);
+    Some((run, epoch))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,9 +139,13 @@ mod tests {
 
     #[test]
     fn orders_and_replies_survive_the_wire_and_hostile_bytes_are_rejected() {
+        assert_eq!(parse_kill(&kill_payload(7, 2)), Some((7, 2)));
+        assert_eq!(parse_kill(&[0; 8]), None);
+        assert_eq!(parse_kill(&[0; 13]), None);
         let order = Order {
             run: 7,
             epoch: 2,
+            number: 3,
             robot: 41,
             action: OrderAction::Respawn {
                 tick: 19,

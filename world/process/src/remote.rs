@@ -63,7 +63,7 @@ pub enum Link {
 impl Link {
     /// The link of a run whose robots are placed on hosts: opens the world's zenoh session.
     pub fn remote(
-        plan: HostsPlan,
+        mut plan: HostsPlan,
         args: &WorldArgs,
         controllers: Vec<String>,
         limits: &Limits,
@@ -74,6 +74,7 @@ impl Link {
         let hosts = plan.place(robots);
         let config = std::path::absolute(&args.config).context("resolving the config path")?;
         let compiled_supervisors = compiled_supervisors(&args.out, &controllers)?;
+        let keys = plan.load_keys().context("reading the hosts' keys")?;
         let options = RemoteOptions {
             listen: plan.listen,
             zenoh: plan.zenoh,
@@ -90,6 +91,7 @@ impl Link {
             max_payload: limits.max_host_message(),
             compiled_supervisors,
             limits: args.limits.clone(),
+            keys,
         };
         let run = SystemTime::now()
             .duration_since(UNIX_EPOCH)
@@ -270,6 +272,7 @@ impl Link {
             "hosts": per_host,
             "stale_payloads": dropped.stale,
             "rejected_payloads": dropped.rejected,
+            "unauthenticated_payloads": dropped.unauthenticated,
         }))
     }
 }

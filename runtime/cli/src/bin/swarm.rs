@@ -27,6 +27,7 @@ use swarm_cli::launcher::control::{self, CtlCommand};
 use swarm_cli::launcher::{self, RunOptions};
 use swarm_contract::config::hosts::TlsFiles;
 use swarm_contract::process::binaries::Binaries;
+use swarm_remote::auth::{HostKey, Seal, create_missing_keys, default_key_dir, key_path};
 use swarm_remote::codec::DEFAULT_MAX_PAYLOAD;
 use swarm_remote::host::{self, HostOptions};
 use swarm_remote::plan::HostsArgs;
@@ -105,6 +106,16 @@ enum Commands {
     /// Run this machine's share of multi-host runs: announce this host, start the robots the world assigns it,
     /// and bridge their frames and commands over zenoh.
     Host(HostCli),
+    /// Create the keys of hosts that have none yet (one private file per host; give each to its host for
+    /// `swarm host --key`). `swarm run --hosts` creates missing keys itself.
+    HostKey {
+        /// Host names.
+        #[arg(required = true)]
+        names: Vec<String>,
+        /// Key folder (default: ~/.config/swarm/keys).
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+    },
     /// Run a grid of configurations x seeds (a TOML grid file); a rerun continues where a stopped one ended.
     Experiment {
         /// The grid file (.toml).
@@ -217,6 +228,13 @@ struct HostCli {
     /// Folder for the agents' logs (default: <temp>/swarm-host-<name>).
     #[arg(long)]
     logs: Option<PathBuf>,
+    /// This host's key, from the world's machine (default: ~/.config/swarm/keys/<name>.key).
+    #[arg(long, value_name = "FILE")]
+    key: Option<PathBuf>,
+    /// Run without a key: accept orders from anyone who can reach this host's zenoh link. Only for a network
+    /// you trust, with a world run with --insecure-hosts.
+    #[arg(long, conflicts_with = "key")]
+    insecure: bool,
 }
 
 /// Exit status of a run stopped by Ctrl-C (or SIGTERM) with its records complete, as shells report SIGINT.
@@ -362,6 +380,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Commands::Ctl { run, request } => done(ctl(&run, request)),
         Commands::Host(cli) => done(run_host(cli)),
+        Commands::HostKey { names, dir } => done(host_key(&names, dir)),
     }
 }
 
@@ -408,6 +427,33 @@ fn run_host(cli: HostCli) -> anyhow::Result<()> {
         ),
         None => None,
     };
+    let seal = if cli.insecure {
+        tracing::warn!(
+            "running without a key: anyone who can reach this host's link can command its robots"
+        );
+        Seal::Off
+    } else {
+        let path = cli
+            .key
+            .or_else(|| default_key_dir().map(|dir| key_path(&dir, &name)))
+            .context("no key file: pass --key FILE (or set HOME)")?;
+        let key = HostKey::read(&path).with_context(|| {
+            format!(
+                "host '{name}' needs its key from the world's machine (`swarm run --hosts` creates it there, as \
+                 does `swarm host-key {name}`)"
+            )
+        })?;
+        Seal::Key(Arc::new(key))
+    };
+    // Without the operator's own zenoh credentials, the host is admitted with its name and its key's password.
+    let (user, password) = match (cli.user, password, &seal) {
+        (Some(user), password, _) => (Some(user), password),
+        (None, _, Seal::Key(key)) => (
+            Some(name.clone()),
+            Some(key.admission_password().to_owned()),
+        ),
+        (None, _, Seal::Off) => (None, None),
+    };
     let tls = TlsFiles {
         root_ca: cli.tls_root_ca,
         certificate: cli.tls_certificate,
@@ -423,20 +469,43 @@ fn run_host(cli: HostCli) -> anyhow::Result<()> {
         zenoh: ZenohOptions {
             config_file: cli.zenoh_config,
             lease: Duration::from_millis(cli.lease_ms),
-            user: cli.user,
+            user,
             password,
             credentials_file: None,
+            admitted: Vec::new(),
             tls,
         },
         max_payload: DEFAULT_MAX_PAYLOAD,
         logs,
         name,
+        seal,
     };
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
     host::serve(&options, &stop).with_context(|| format!("host '{}'", options.name))
+}
+
+/// `swarm host-key`: creates the missing keys and says where each host's key is.
+fn host_key(names: &[String], dir: Option<PathBuf>) -> anyhow::Result<()> {
+    for name in names {
+        swarm_contract::config::hosts::check_host_name(name)?;
+    }
+    let dir = dir
+        .or_else(default_key_dir)
+        .context("no key folder: pass --dir DIR (or set HOME)")?;
+    let created = create_missing_keys(&dir, names.iter().map(String::as_str))?;
+    for name in names {
+        let path = key_path(&dir, name);
+        let state = if created.contains(&path) {
+            "created"
+        } else {
+            "exists"
+        };
+        println!("{name}\t{}\t{state}", path.display());
+    }
+    Ok(())
 }
 
 /// `swarm experiment`: runs the batch, prints where its results are, and fails if any run failed.

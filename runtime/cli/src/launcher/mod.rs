@@ -52,7 +52,7 @@ use swarm_contract::protocol::launcher_to_world::WorldCommand;
 use swarm_contract::protocol::world_to_launcher::WorldReport;
 use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE, RunDirError};
 use swarm_contract::transport::{self, RunSpec};
-use swarm_remote::plan::{HostsArgs, HostsError, HostsPlan};
+use swarm_remote::plan::{Authentication, HostsArgs, HostsError, HostsPlan};
 
 /// How often the supervision loop looks at its children when the world is quiet.
 const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
@@ -247,8 +247,11 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
              Ctrl-C or until its loop functions end the experiment"
         );
     }
-    let placement = HostsPlan::resolve(experiment.framework.hosts.as_ref(), &options.hosts)?
-        .map(|plan| plan.place(robots));
+    let plan = HostsPlan::resolve(experiment.framework.hosts.as_ref(), &options.hosts)?;
+    if let Some(plan) = &plan {
+        announce_host_keys(plan)?;
+    }
+    let placement = plan.map(|plan| plan.place(robots));
     let started_at = SystemTime::now();
     // Held (locked) until the run is over.
     let run_folder = run_dir::create(options.out.as_deref(), options.overwrite, &options.config)?;
@@ -480,6 +483,25 @@ fn check_controllers(
     run_dir::write_atomically(&path, text.as_bytes())
         .map_err(io(format!("writing {}", path.display())))?;
     Ok(compiled)
+}
+
+/// Creates the keys of the run's hosts that do not exist yet and tells the operator where they are; warns when
+/// authentication is off.
+fn announce_host_keys(plan: &HostsPlan) -> Result<(), HostsError> {
+    if plan.authentication == Authentication::Off {
+        tracing::warn!(
+            "host authentication is off: anyone who can reach {} can join, listen in and command robots",
+            plan.listen.join(", ")
+        );
+    }
+    for path in plan.create_missing_keys()? {
+        tracing::warn!(
+            "created the host key {}: copy it to that host (readable by its user only) and start it with `swarm \
+             host --key <file>`",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// A seed from the clock, for configurations that ask for one.

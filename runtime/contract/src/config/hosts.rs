@@ -22,6 +22,7 @@
 use std::path::{Path, PathBuf};
 
 use super::model::{Element, Location};
+use super::values::Value;
 
 /// Longest host name (it is one zenoh key chunk and part of log lines).
 pub const MAX_HOST_NAME: usize = 64;
@@ -126,6 +127,10 @@ pub struct HostsConfig {
     pub credentials_file: Option<PathBuf>,
     /// The world's TLS certificate and key, and the authority hosts' certificates must be signed by.
     pub tls: TlsFiles,
+    /// Folder of the hosts' keys (`<name>.key`), if set.
+    pub keys: Option<PathBuf>,
+    /// Whether authentication is off (`insecure="true"`: anyone who reaches the endpoint can speak).
+    pub insecure: bool,
     /// The hosts, in file order.
     pub hosts: Vec<HostEntry>,
     /// Where the element is.
@@ -142,6 +147,8 @@ const ATTRIBUTES: &[&str] = &[
     "tls_certificate",
     "tls_private_key",
     "tls_root_ca",
+    "keys",
+    "insecure",
 ];
 
 /// Parses a `<hosts>` element; relative paths are resolved against `base`. Returns the element (when usable)
@@ -215,6 +222,19 @@ pub(crate) fn parse(el: &Element, base: &Path) -> (Option<HostsConfig>, Vec<(Loc
                 .into(),
         ));
     }
+    let insecure = text("insecure").is_some_and(|(v, at)| {
+        bool::parse_value(v).unwrap_or_else(|e| {
+            errors.push((at, format!("invalid 'insecure' in <hosts>: {e}")));
+            false
+        })
+    });
+    if insecure && text("keys").is_some() {
+        errors.push((
+            el.location,
+            "<hosts> has both 'keys' and insecure=\"true\": keys authenticate hosts, insecure turns that off"
+                .into(),
+        ));
+    }
     let mut hosts: Vec<HostEntry> = Vec::new();
     for child in &el.children {
         if child.name != "host" {
@@ -256,6 +276,8 @@ pub(crate) fn parse(el: &Element, base: &Path) -> (Option<HostsConfig>, Vec<(Loc
             certificate: path("tls_certificate"),
             private_key: path("tls_private_key"),
         },
+        keys: path("keys"),
+        insecure,
         hosts,
         location: el.location,
     };
