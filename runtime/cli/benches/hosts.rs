@@ -1,5 +1,6 @@
-//! Multi-host throughput: 2 hosts x 50 robots against 1 host x 100 robots (and the local run of 100 robots), in
-//! robot-steps per second, as ratios measured in one run of this benchmark.
+//! Multi-host throughput: 2 hosts x 50 robots against 1 host x 100 robots (and the local run of 100 robots), and
+//! 2 hosts x 50 with host authentication on (the default) against off (`--insecure-hosts`), in robot-steps per
+//! second, as ratios measured in one run of this benchmark.
 //!
 //! Every configuration runs the obstacle-avoidance experiment with real processes: `swarm run` (world), `swarm
 //! host` daemons on loopback and one agent process per robot, so all of them share this machine's cores. Each is
@@ -50,18 +51,56 @@ impl Drop for Daemon {
     }
 }
 
+/// Host authentication of a run.
+#[derive(Clone, Copy)]
+enum Auth {
+    /// Keys from this folder (the default of `swarm run --hosts`).
+    On,
+    /// `--insecure-hosts` / `swarm host --insecure`.
+    Off,
+}
+
 /// One run; returns the world's robot-steps per second.
-fn run(ticks: u64, hosts: u32) -> f64 {
+fn run(ticks: u64, hosts: u32, auth: Auth, keys: &Path) -> f64 {
     let out =
         std::env::temp_dir().join(format!("swarm-bench-hosts-{}-{hosts}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let endpoint = free_endpoint();
     let names: Vec<String> = (0..hosts).map(|i| format!("bench{i}")).collect();
+    let (run_auth, host_auth): (Vec<String>, Vec<Vec<String>>) = match auth {
+        Auth::On => {
+            let status = Command::new(swarm())
+                .args(["host-key", "--dir"])
+                .arg(keys)
+                .args(&names)
+                .stdout(Stdio::null())
+                .status();
+            assert!(status.is_ok_and(|s| s.success() || names.is_empty()));
+            (
+                vec!["--keys".into(), keys.display().to_string()],
+                names
+                    .iter()
+                    .map(|n| {
+                        vec![
+                            "--key".into(),
+                            keys.join(format!("{n}.key")).display().to_string(),
+                        ]
+                    })
+                    .collect(),
+            )
+        }
+        Auth::Off => (
+            vec!["--insecure-hosts".into()],
+            names.iter().map(|_| vec!["--insecure".into()]).collect(),
+        ),
+    };
     let _daemons: Vec<Daemon> = names
         .iter()
-        .map(|name| {
+        .zip(&host_auth)
+        .map(|(name, auth)| {
             let child = Command::new(swarm())
                 .args(["host", "--connect", &endpoint, "--name", name])
+                .args(auth)
                 .env("RUST_LOG", "warn")
                 .current_dir(workspace())
                 .stdout(Stdio::null())
@@ -89,6 +128,7 @@ fn run(ticks: u64, hosts: u32) -> f64 {
         .stdout(Stdio::null());
     if hosts > 0 {
         command.args(["--hosts", &names.join(","), "--listen", &endpoint]);
+        command.args(&run_auth);
     }
     let status = command.status().expect("swarm run starts");
     assert!(status.success(), "swarm run with {hosts} hosts failed");
@@ -108,21 +148,38 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(400);
+    let keys = std::env::temp_dir().join(format!("swarm-bench-keys-{}", std::process::id()));
     // Let the launcher build the world and agent programs once before measuring.
-    run(5, 0);
+    run(5, 0, Auth::On, &keys);
     let mut local = Vec::new();
     let mut one = Vec::new();
     let mut two = Vec::new();
+    let mut two_insecure = Vec::new();
     for _ in 0..ROUNDS {
-        local.push(run(ticks, 0));
-        one.push(run(ticks, 1));
-        two.push(run(ticks, 2));
+        local.push(run(ticks, 0, Auth::On, &keys));
+        one.push(run(ticks, 1, Auth::On, &keys));
+        two.push(run(ticks, 2, Auth::On, &keys));
+        two_insecure.push(run(ticks, 2, Auth::Off, &keys));
     }
-    let (local, one, two) = (median(local), median(one), median(two));
+    let _ = std::fs::remove_dir_all(&keys);
+    let (local, one, two, two_insecure) = (
+        median(local),
+        median(one),
+        median(two),
+        median(two_insecure),
+    );
     println!("hosts: {ROBOTS} robots, {ticks} ticks, median of {ROUNDS} rounds (robot-steps/s)");
     println!("  local, no zenoh      {local:>10.0}");
     println!("  1 host  x {ROBOTS:>3}       {one:>10.0}");
     println!("  2 hosts x {:>3}       {two:>10.0}", ROBOTS / 2);
+    println!(
+        "  2 hosts x {:>3}, insecure {two_insecure:>6.0}",
+        ROBOTS / 2
+    );
+    println!(
+        "  authentication on / off {:>7.0}%",
+        100.0 * two / two_insecure
+    );
     println!(
         "  ratio 2x{} / 1x{ROBOTS}    {:>9.0}%",
         ROBOTS / 2,
