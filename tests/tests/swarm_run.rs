@@ -154,6 +154,46 @@ fn same_seed_gives_identical_trajectory_and_events() {
 }
 
 #[test]
+fn the_run_folders_configuration_reruns_the_same_run_from_elsewhere() {
+    let first = temp_dir();
+    run_ok(
+        OBSTACLE_AVOIDANCE,
+        first.path(),
+        &[
+            "--robots",
+            "6",
+            "--ticks",
+            "45",
+            "--seed",
+            "5",
+            "--fault",
+            "kill robots=1 tick=10",
+            "--limit",
+            "tick_deadline_ms=400",
+        ],
+    );
+    // A copy in a folder of its own: relative paths in it would no longer resolve.
+    let elsewhere = temp_dir();
+    let copy = elsewhere.path().join("config.argos");
+    std::fs::copy(first.path().join("config.argos"), &copy).expect("copy the configuration");
+    let second = temp_dir();
+    run_ok(&copy.display().to_string(), second.path(), &[]);
+    for name in ["trajectory.csv", "events.csv"] {
+        let read = |dir: &Path| std::fs::read(dir.join(name)).expect("a record");
+        assert!(
+            read(first.path()) == read(second.path()),
+            "{name} of the rerun differs from the run"
+        );
+    }
+    let (original, rerun) = (summary(first.path()), summary(second.path()));
+    for field in ["ticks", "robots", "seed", "deaths", "limits"] {
+        assert_eq!(original[field], rerun[field], "summary field {field}");
+    }
+    assert_eq!(original["ticks"], 45);
+    assert_eq!(original["robots"], 6);
+}
+
+#[test]
 fn thesis_and_argos_example_configurations_run_unchanged() {
     for config in [
         "configs/obstacle_avoidance/thesis_example.argos",

@@ -19,7 +19,18 @@ struct Node {
     attributes: Vec<(String, Range<usize>)>,
     /// Byte offset right after the tag name, where a new attribute is inserted.
     name_end: usize,
+    /// Where new children go: the offset of the end tag, or for a self-closing element the range of its `/>`.
+    content_end: ContentEnd,
     children: Vec<usize>,
+}
+
+/// Where the content of an element ends.
+#[derive(Debug, Clone, Copy)]
+enum ContentEnd {
+    /// Byte offset of `</name>`.
+    EndTag(usize),
+    /// Byte offset of the `/>` of a self-closing element.
+    SelfClosing(usize),
 }
 
 /// An indexed `.argos` text.
@@ -75,6 +86,7 @@ impl Document {
         let mut stack: Vec<usize> = Vec::new();
         let mut roots: Vec<usize> = Vec::new();
         loop {
+            let before = offset(reader.buffer_position());
             let event = reader.read_event().map_err(|e| DocumentError::Malformed {
                 offset: offset(reader.error_position()),
                 message: e.to_string(),
@@ -84,7 +96,11 @@ impl Document {
                     let empty = text
                         .get(..offset(reader.buffer_position()))
                         .is_some_and(|before| before.ends_with("/>"));
-                    let node = index_tag(text, &start)?;
+                    let mut node = index_tag(text, &start)?;
+                    if empty {
+                        node.content_end =
+                            ContentEnd::SelfClosing(offset(reader.buffer_position()) - 2);
+                    }
                     let id = nodes.len();
                     nodes.push(node);
                     match stack.last() {
@@ -96,7 +112,9 @@ impl Document {
                     }
                 }
                 Event::End(_) => {
-                    stack.pop();
+                    if let Some(node) = stack.pop() {
+                        nodes[node].content_end = ContentEnd::EndTag(before);
+                    }
                 }
                 Event::Eof => break,
                 _ => {}
@@ -204,6 +222,43 @@ impl Document {
         text
     }
 
+    /// The text with `child` (XML) added as the last child of the first element at `path` (element names from
+    /// the root's children down); missing elements of the path are created.
+    pub fn with_child(&self, path: &[&str], child: &str) -> String {
+        let mut node = self.root;
+        for (depth, name) in path.iter().enumerate() {
+            let next = self.nodes[node]
+                .children
+                .iter()
+                .copied()
+                .find(|&c| self.nodes[c].name == *name);
+            match next {
+                Some(next) => node = next,
+                None => {
+                    let mut created = child.to_owned();
+                    for name in path[depth..].iter().rev() {
+                        created = format!("<{name}>\n{created}\n</{name}>");
+                    }
+                    return self.insert_into(node, &created);
+                }
+            }
+        }
+        self.insert_into(node, child)
+    }
+
+    /// The text with `xml` inserted at the end of element `node`'s content.
+    fn insert_into(&self, node: usize, xml: &str) -> String {
+        let mut text = self.text.clone();
+        match self.nodes[node].content_end {
+            ContentEnd::EndTag(at) => text.insert_str(at, &format!("{xml}\n")),
+            ContentEnd::SelfClosing(at) => {
+                let name = &self.nodes[node].name;
+                text.replace_range(at..at + 2, &format!(">\n{xml}\n</{name}>"));
+            }
+        }
+        text
+    }
+
     fn attribute(&self, node: usize, name: &str) -> Option<Range<usize>> {
         self.nodes[node]
             .attributes
@@ -299,6 +354,7 @@ fn index_tag(text: &str, start: &BytesStart<'_>) -> Result<Node, DocumentError> 
     }
     Ok(Node {
         name_end: raw_at + start.name().as_ref().len(),
+        content_end: ContentEnd::EndTag(raw_at),
         name,
         attributes,
         children: Vec::new(),
@@ -325,6 +381,31 @@ mod tests {
   </controllers>
 </argos-configuration>
 "#;
+
+    #[test]
+    fn children_go_last_into_existing_self_closing_or_created_elements() {
+        let document = Document::parse(TEXT).expect("parses");
+        let added = document.with_child(&["arena"], "<box id=\"b2\"/>");
+        assert!(
+            added.contains("</distribute>\n  <box id=\"b2\"/>\n</arena>"),
+            "{added}"
+        );
+        let created = document.with_child(&["framework", "system"], "<x/>");
+        assert!(
+            created.contains(
+                "<framework>\n<system>\n<x/>\n</system>\n</framework>\n</argos-configuration>"
+            ),
+            "{created}"
+        );
+        let closed = Document::parse("<a><b k=\"1\"/></a>").expect("parses");
+        assert_eq!(
+            closed.with_child(&["b"], "<c/>"),
+            "<a><b k=\"1\">\n<c/>\n</b></a>"
+        );
+        for text in [added, created] {
+            Document::parse(&text).expect("still well-formed");
+        }
+    }
 
     fn set(text: &str, address: &str, value: &str) -> String {
         let document = Document::parse(text).unwrap_or_else(|e| panic!("{e}"));

@@ -307,7 +307,7 @@ fn run_one(
     };
     match launcher::run(&options, Arc::clone(stop)) {
         Ok(report) if report.interrupted => Outcome::Interrupted,
-        Ok(_) => match batch.complete(&configuration.id, seed, grid.ticks) {
+        Ok(_) => match batch.complete(configuration, seed, grid.ticks) {
             Ok(_) => Outcome::Completed,
             Err(e) => Outcome::Failed(format!("completing {}: {e}", partial.display())),
         },

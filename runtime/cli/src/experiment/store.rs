@@ -9,14 +9,16 @@
 //!
 //! A run is written under its `.partial` name and renamed when complete, so a killed batch never leaves a
 //! partial run under a finished name; a finished run whose configuration text or ticks no longer match the grid
-//! is stale and is run again. This module never deletes anything outside the batch folder.
+//! is stale and is run again. The run's marker records the SHA-256 of the derived configuration text it ran
+//! (the run folder's own `config.argos` is the configuration as run, with absolute paths and the seed written in,
+//! so it is not compared). This module never deletes anything outside the batch folder.
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use super::plan::Configuration;
-use swarm_contract::run_dir::{CONFIG_COPY_FILE, RUN_MARKER};
+use swarm_contract::run_dir::RUN_MARKER;
 
 /// What the batch folder says about one run.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -34,6 +36,17 @@ struct RunMarker {
     configuration: String,
     seed: u64,
     ticks: Option<u64>,
+    /// SHA-256 (hex) of the derived configuration text the run was started with.
+    configuration_sha256: String,
+}
+
+/// SHA-256 of `text`, in hex.
+fn sha256(text: &str) -> String {
+    ring::digest::digest(&ring::digest::SHA256, text.as_bytes())
+        .as_ref()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// A batch folder.
@@ -97,18 +110,17 @@ impl BatchDir {
             configuration: configuration.id.clone(),
             seed,
             ticks,
+            configuration_sha256: sha256(&configuration.text),
         };
-        if marker.as_ref() != Some(&expected) {
-            return RunState::Stale(format!(
-                "{} does not record this run's seed and ticks",
-                RUN_MARKER
-            ));
+        match marker {
+            Some(marker) if marker == expected => RunState::Finished,
+            Some(marker) if marker.configuration_sha256 != expected.configuration_sha256 => {
+                RunState::Stale("its configuration differs from the grid's".into())
+            }
+            _ => RunState::Stale(format!(
+                "{RUN_MARKER} does not record this run's configuration, seed and ticks"
+            )),
         }
-        let used = std::fs::read_to_string(dir.join(CONFIG_COPY_FILE)).unwrap_or_default();
-        if used != configuration.text {
-            return RunState::Stale("its configuration differs from the grid's".into());
-        }
-        RunState::Finished
     }
 
     /// Removes a run's partial directory (left by an interrupted or killed batch) and, for a stale run, its old
@@ -124,12 +136,19 @@ impl BatchDir {
 
     /// Marks a completed run and moves it to its finished name (one rename: a killed batch leaves either the
     /// partial directory or the finished one).
-    pub fn complete(&self, id: &str, seed: u64, ticks: Option<u64>) -> std::io::Result<PathBuf> {
+    pub fn complete(
+        &self,
+        configuration: &Configuration,
+        seed: u64,
+        ticks: Option<u64>,
+    ) -> std::io::Result<PathBuf> {
+        let id = configuration.id.as_str();
         let partial = self.partial_dir(id, seed);
         let marker = RunMarker {
             configuration: id.to_owned(),
             seed,
             ticks,
+            configuration_sha256: sha256(&configuration.text),
         };
         let text = serde_json::to_string_pretty(&marker).map_err(std::io::Error::other)?;
         swarm_contract::run_dir::write_atomically(
@@ -158,8 +177,9 @@ mod tests {
     fn finish_run(batch: &BatchDir, text: &str, seed: u64, ticks: Option<u64>) {
         let partial = batch.partial_dir("Nr-4", seed);
         std::fs::create_dir_all(&partial).expect("partial dir");
-        std::fs::write(partial.join("config.argos"), text).expect("config copy");
-        batch.complete("Nr-4", seed, ticks).expect("rename");
+        batch
+            .complete(&configuration(text), seed, ticks)
+            .expect("rename");
     }
 
     #[test]

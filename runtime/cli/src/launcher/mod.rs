@@ -16,6 +16,7 @@
 //! cuts the records back to the last complete tick ([`records`]), writes the summary and fails with the reason.
 
 mod agents;
+pub mod as_run;
 pub mod control;
 mod fault_handling;
 pub mod fault_log;
@@ -145,6 +146,9 @@ pub enum LaunchError {
     /// The hosts of the run cannot be resolved.
     #[error(transparent)]
     Hosts(#[from] HostsError),
+    /// The configuration could not be rewritten as the run used it.
+    #[error("{0}")]
+    AsRun(String),
     /// The run needs more open files than this machine allows.
     #[error(transparent)]
     OpenFiles(#[from] swarm_contract::process::open_files::TooManyFiles),
@@ -272,6 +276,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     };
     let schedule = FaultSchedule::for_run(&experiment, &options.faults, robots)?;
     let ticks_per_second = experiment.framework.ticks_per_second;
+    write_configuration_as_run(options, &experiment, &config, seed, &out_dir)?;
     let mut startup = Vec::new();
     FaultPlan::new(&schedule, ticks_per_second, seed).due(
         0,
@@ -483,6 +488,46 @@ fn check_controllers(
     run_dir::write_atomically(&path, text.as_bytes())
         .map_err(io(format!("writing {}", path.display())))?;
     Ok(compiled)
+}
+
+/// Replaces the run folder's copy of the configuration with the configuration as this run used it (see
+/// [`as_run`]), so that it reruns the same experiment from anywhere.
+fn write_configuration_as_run(
+    options: &RunOptions,
+    experiment: &Experiment,
+    config: &Path,
+    seed: u64,
+    out_dir: &Path,
+) -> Result<(), LaunchError> {
+    let text = swarm_contract::config::input::read_text(
+        config,
+        swarm_contract::config::input::MAX_CONFIG_BYTES,
+    )
+    .map_err(|e| LaunchError::AsRun(e.to_string()))?;
+    let epuck_quantity = options.robots.and_then(|_| {
+        experiment
+            .arena
+            .distributions
+            .iter()
+            .find(|d| matches!(d.template, swarm_contract::config::Entity::EPuck(_)))
+            .map(|d| d.quantity)
+    });
+    let overrides = as_run::Overrides {
+        seed,
+        ticks: options
+            .ticks
+            .map(|ticks| (ticks, experiment.framework.ticks_per_second)),
+        epuck_quantity,
+        limits: &options.limits,
+        faults: &options.faults,
+    };
+    let rewritten = as_run::configuration_as_run(&text, config, &overrides)
+        .map_err(|e| LaunchError::AsRun(e.to_string()))?;
+    run_dir::write_atomically(
+        &out_dir.join(run_dir::CONFIG_COPY_FILE),
+        rewritten.as_bytes(),
+    )
+    .map_err(io("writing the configuration as run"))
 }
 
 /// Creates the keys of the run's hosts that do not exist yet and tells the operator where they are; warns when

@@ -601,6 +601,19 @@ pub fn parse_robot_list(text: &str) -> Result<Vec<u32>, String> {
     Ok(robots)
 }
 
+/// A `--fault` text as the `<faults>` child it stands for: `kill robots=3 tick=50` is `<kill robots="3"
+/// tick="50"/>`. Check the text with [`FaultSchedule::for_run`] first; this only rewrites it.
+pub fn fault_text_as_xml(text: &str) -> Result<String, String> {
+    let el = element_from_words(text).map_err(|(_, message)| message)?;
+    let mut xml = format!("<{}", el.name);
+    for (name, attribute) in &el.attributes {
+        let value = quick_xml::escape::escape(attribute.value.as_str());
+        xml.push_str(&format!(" {name}=\"{value}\""));
+    }
+    xml.push_str("/>");
+    Ok(xml)
+}
+
 /// Turns `--fault` words (`kill robots=3 tick=50`) into an element located at their columns.
 fn element_from_words(text: &str) -> Result<Element, (u32, String)> {
     let mut words = text
