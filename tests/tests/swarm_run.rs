@@ -194,6 +194,67 @@ fn the_run_folders_configuration_reruns_the_same_run_from_elsewhere() {
 }
 
 #[test]
+fn a_run_stops_cleanly_at_its_disk_budget_with_its_records_complete() {
+    let out = temp_dir();
+    let out_arg = out.path().display().to_string();
+    // No length: only the budget ends the run.
+    let outcome = swarm(&[
+        "run",
+        OBSTACLE_AVOIDANCE,
+        "--ticks",
+        "0",
+        "--no-progress",
+        "--out",
+        &out_arg,
+        "--limit",
+        "records_max_mb=1",
+    ]);
+    assert_clean(&outcome);
+    let stderr = outcome.stderr();
+    assert!(!outcome.output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("stopped after") && stderr.contains("records_max_mb"),
+        "{stderr}"
+    );
+    let summary = summary(out.path());
+    assert!(summary["stopped_early"].is_string(), "{summary:#}");
+    let ticks = summary["ticks"].as_u64().expect("ticks");
+    assert!(ticks > 0, "{summary:#}");
+    let trajectory =
+        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    assert!(trajectory.ends_with('\n'), "a torn last line");
+    let last_tick: u64 = trajectory
+        .lines()
+        .last()
+        .and_then(|line| line.split(',').next())
+        .and_then(|tick| tick.parse().ok())
+        .expect("a last row");
+    assert_eq!(
+        last_tick, ticks,
+        "the last recorded tick is the last tick run"
+    );
+
+    let full = temp_dir();
+    let full_arg = full.path().display().to_string();
+    let outcome = swarm(&[
+        "run",
+        OBSTACLE_AVOIDANCE,
+        "--no-progress",
+        "--out",
+        &full_arg,
+        "--limit",
+        "disk_reserve_mb=1000000000000",
+    ]);
+    assert_clean(&outcome);
+    let stderr = outcome.stderr();
+    assert!(!outcome.output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("not starting the run") && stderr.contains("disk_reserve_mb"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn thesis_and_argos_example_configurations_run_unchanged() {
     for config in [
         "configs/obstacle_avoidance/thesis_example.argos",

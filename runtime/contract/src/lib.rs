@@ -21,6 +21,7 @@
 pub mod alloc_count;
 pub mod config;
 pub mod cpu;
+pub mod disk_budget;
 pub mod fault_plan;
 pub mod limits;
 pub mod logging;

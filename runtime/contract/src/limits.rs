@@ -43,6 +43,12 @@ pub struct Limits {
     /// How long a joining agent waits for the death notice of its robot's previous agent and for the world to
     /// replace the robot's command board, in milliseconds. Default 30,000.
     pub agent_board_wait_ms: u64,
+    /// Free space the run leaves on the disk of its run folder, in MiB: when less is free the run stops, with
+    /// its records complete. Default 1,024.
+    pub disk_reserve_mb: u64,
+    /// Largest size of a run folder, in MiB: a run whose records grow past it stops, with its records complete.
+    /// Default 1,048,576 (1 TiB).
+    pub records_max_mb: u64,
 }
 
 /// Largest message the world accepts from a host by default.
@@ -60,6 +66,8 @@ impl Default for Limits {
             max_host_message_bytes: DEFAULT_MAX_HOST_MESSAGE_BYTES,
             agent_join_retry_ms: 10_000,
             agent_board_wait_ms: 30_000,
+            disk_reserve_mb: 1024,
+            records_max_mb: 1 << 20,
         }
     }
 }
@@ -88,7 +96,7 @@ pub enum LimitError {
 
 impl Limits {
     /// The names of the limits, as `<system>` attributes and `--limit` names.
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 11] = [
         "tick_deadline_ms",
         "join_timeout_ms",
         "world_ready_timeout_ms",
@@ -98,6 +106,8 @@ impl Limits {
         "max_host_message_bytes",
         "agent_join_retry_ms",
         "agent_board_wait_ms",
+        "disk_reserve_mb",
+        "records_max_mb",
     ];
 
     fn field(&mut self, name: &str) -> Option<&mut u64> {
@@ -111,6 +121,8 @@ impl Limits {
             "max_host_message_bytes" => &mut self.max_host_message_bytes,
             "agent_join_retry_ms" => &mut self.agent_join_retry_ms,
             "agent_board_wait_ms" => &mut self.agent_board_wait_ms,
+            "disk_reserve_mb" => &mut self.disk_reserve_mb,
+            "records_max_mb" => &mut self.records_max_mb,
             _ => return None,
         })
     }

@@ -25,6 +25,7 @@ use anyhow::Context;
 use clap::Parser;
 use swarm_contract::config::Experiment;
 use swarm_contract::config::faults::FaultSchedule;
+use swarm_contract::disk_budget::DiskBudget;
 use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::protocol::world_to_launcher::WorldReport;
@@ -153,6 +154,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut commands_missing: u64 = 0;
     let mut last_report = Instant::now();
     let mut tick_micros: Vec<u32> = Vec::with_capacity(args.ticks.min(1 << 24) as usize);
+    let mut budget = DiskBudget::new(&args.out, limits.disk_reserve_mb, limits.records_max_mb);
+    let mut stopped_early = None;
     while !stop.load(Ordering::Relaxed) && !world.is_finished() {
         faults.before_tick(
             link.tick() + 1,
@@ -191,6 +194,11 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             });
         }
         pacer.end_of_tick(outcome.tick);
+        if let Some(reason) = budget.exceeded() {
+            tracing::error!(tick = outcome.tick, "stopping the run: {reason}");
+            stopped_early = Some(reason);
+            break;
+        }
     }
     let ticking = started.elapsed().as_secs_f64();
     let cpu = cpu.map(|cpu| cpu.summary(&link, robot_steps));
@@ -204,6 +212,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         "tick_micros_p99": percentile(&mut tick_micros, 0.99),
         "real_time": pacer.summary(ticks),
         "limits": limits,
+        "stopped_early": stopped_early,
     });
     if let Some(object) = extra.as_object_mut() {
         object.insert("alive_final".into(), faults.alive_count().into());

@@ -43,6 +43,7 @@ use plain_progress::PlainProgress;
 use restart::RestartTracker;
 use swarm_contract::config::faults::{FaultKind, FaultSchedule};
 use swarm_contract::config::{ConfigErrors, Experiment};
+use swarm_contract::disk_budget::DiskBudget;
 use swarm_contract::fault_plan::FaultPlan;
 use swarm_contract::limits::LimitError;
 use swarm_contract::process::binaries::{Binaries, BinariesError};
@@ -146,6 +147,23 @@ pub enum LaunchError {
     /// The hosts of the run cannot be resolved.
     #[error(transparent)]
     Hosts(#[from] HostsError),
+    /// The world stopped the run before its end to stay within its disk budget; the records up to `ticks` are
+    /// complete.
+    #[error(
+        "stopped after {ticks} ticks: {reason}; the records up to that tick are complete in {}",
+        out_dir.display()
+    )]
+    StoppedEarly {
+        /// Ticks completed.
+        ticks: u64,
+        /// Which limit, and by how much.
+        reason: String,
+        /// The run folder.
+        out_dir: PathBuf,
+    },
+    /// The run folder's disk is below the run's reserve (or the folder past its size) before the run starts.
+    #[error("not starting the run: {0}")]
+    NoRoom(String),
     /// The configuration could not be rewritten as the run used it.
     #[error("{0}")]
     AsRun(String),
@@ -260,6 +278,11 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     // Held (locked) until the run is over.
     let run_folder = run_dir::create(options.out.as_deref(), options.overwrite, &options.config)?;
     let out_dir = run_folder.path.clone();
+    if let Some(reason) =
+        DiskBudget::new(&out_dir, limits.disk_reserve_mb, limits.records_max_mb).check()
+    {
+        return Err(LaunchError::NoRoom(reason));
+    }
     let binaries = Binaries::locate()?;
     RunSpec::remove_dead_runs();
     let spec = RunSpec::unique();
@@ -419,7 +442,21 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     supervision.progress.finish_and_clear();
     let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
     complete_summary(&out_dir, &report, &provenance, None)?;
+    if let Some(reason) = stopped_early(&out_dir) {
+        return Err(LaunchError::StoppedEarly {
+            ticks: report.ticks,
+            reason,
+            out_dir,
+        });
+    }
     Ok(report)
+}
+
+/// Why the world stopped the run before its end (its disk budget), as its `summary.json` says.
+fn stopped_early(out_dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(out_dir.join(run_dir::SUMMARY_FILE)).ok()?;
+    let summary: serde_json::Value = serde_json::from_str(&text).ok()?;
+    summary["stopped_early"].as_str().map(str::to_owned)
 }
 
 /// Builds every controller of the run once, before any process of the run starts (`robot-agent --check` for the
