@@ -44,7 +44,7 @@ pub struct Limits {
     /// replace the robot's command board, in milliseconds. Default 30,000.
     pub agent_board_wait_ms: u64,
     /// Free space the run leaves on the disk of its run folder, in MiB: when less is free the run stops, with
-    /// its records complete. Default 1,024.
+    /// its records complete. Default 100.
     pub disk_reserve_mb: u64,
     /// Largest size of a run folder, in MiB: a run whose records grow past it stops, with its records complete.
     /// Default 1,048,576 (1 TiB).
@@ -66,7 +66,7 @@ impl Default for Limits {
             max_host_message_bytes: DEFAULT_MAX_HOST_MESSAGE_BYTES,
             agent_join_retry_ms: 10_000,
             agent_board_wait_ms: 30_000,
-            disk_reserve_mb: 1024,
+            disk_reserve_mb: 100,
             records_max_mb: 1 << 20,
         }
     }
