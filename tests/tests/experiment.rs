@@ -234,3 +234,78 @@ fn grid_with_an_address_matching_nothing_fails_before_any_run() {
         "no run started"
     );
 }
+
+#[test]
+fn shards_share_the_grid_once_and_merge_into_one_table() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let grid = write_grid(dir.path());
+    let grid_arg = grid.display().to_string();
+    let batch_dir = dir.path().join("batch");
+    for shard in ["1/2", "2/2"] {
+        let outcome = swarm(&["experiment", &grid_arg, "--shard", shard, "--no-progress"]);
+        assert_clean(&outcome);
+        assert!(
+            outcome.output.status.success(),
+            "shard {shard} failed:\n{}",
+            outcome.stderr()
+        );
+    }
+    let first = finished_runs(&batch_dir.join("shard-1-of-2"));
+    let second = finished_runs(&batch_dir.join("shard-2-of-2"));
+    assert_eq!((first.len(), second.len()), (2, 2), "{first:?} {second:?}");
+    assert!(
+        first.keys().all(|run| !second.contains_key(run)),
+        "a run belongs to both shards: {first:?} {second:?}"
+    );
+
+    let merged = dir.path().join("merged");
+    let merged_arg = merged.display().to_string();
+    let shard_args: Vec<String> = ["shard-1-of-2", "shard-2-of-2"]
+        .iter()
+        .flat_map(|s| {
+            [
+                "--merge".to_owned(),
+                batch_dir.join(s).display().to_string(),
+            ]
+        })
+        .collect();
+    let mut args = vec![
+        "experiment",
+        grid_arg.as_str(),
+        "--out",
+        merged_arg.as_str(),
+    ];
+    args.extend(shard_args.iter().map(String::as_str));
+    let outcome = swarm(&args);
+    assert!(
+        outcome.output.status.success(),
+        "merge failed:\n{}",
+        outcome.stderr()
+    );
+    let table = std::fs::read_to_string(merged.join("results.csv")).expect("results.csv");
+    let runs = table.lines().filter(|l| l.starts_with("run,")).count();
+    assert_eq!(runs, 4, "every run of the grid in one table:\n{table}");
+    assert!(merged.join("report.md").is_file());
+    assert!(!merged.join("runs").exists(), "a merge runs nothing");
+}
+
+#[test]
+fn a_batch_folder_has_one_writer() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let grid = write_grid(dir.path());
+    let batch_dir = dir.path().join("batch");
+    let _held = swarm_contract::run_dir::lock_folder(&batch_dir).expect("the folder locks");
+    let outcome = swarm(&["experiment", &grid.display().to_string(), "--no-progress"]);
+    assert!(!outcome.output.status.success());
+    assert!(
+        outcome
+            .stderr()
+            .contains("another swarm run or experiment is writing into it"),
+        "{}",
+        outcome.stderr()
+    );
+    assert!(
+        !batch_dir.join("runs").exists(),
+        "the refused batch touched the folder"
+    );
+}

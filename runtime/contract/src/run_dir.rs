@@ -42,7 +42,7 @@ pub const LOCK_FILE: &str = ".swarm.lock";
 #[derive(Debug, thiserror::Error)]
 pub enum RunDirError {
     /// Another launcher holds the folder's lock.
-    #[error("{}: another run is writing into it (its launcher holds {LOCK_FILE})", path.display())]
+    #[error("{}: another swarm run or experiment is writing into it (it holds {LOCK_FILE})", path.display())]
     InUse {
         /// The folder.
         path: PathBuf,
@@ -149,6 +149,13 @@ fn claim(dir: &Path, overwrite: bool) -> Result<RunDir, RunDirError> {
         removed.map_err(io_error("removing", &entry))?;
     }
     Ok(run_dir)
+}
+
+/// Creates `dir` if needed and locks it for this process (e.g. a batch folder of `swarm experiment`), or says
+/// that another process holds it.
+pub fn lock_folder(dir: &Path) -> Result<RunDir, RunDirError> {
+    std::fs::create_dir_all(dir).map_err(io_error("creating", dir))?;
+    lock(dir.to_path_buf())
 }
 
 /// Locks `path`'s lock file for this process, or says who has it.

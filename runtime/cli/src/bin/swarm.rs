@@ -22,7 +22,7 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 use swarm_cli::bench::BenchOptions;
-use swarm_cli::experiment::{self, ExperimentOptions};
+use swarm_cli::experiment::{self, ExperimentOptions, Shard};
 use swarm_cli::launcher::control::{self, CtlCommand};
 use swarm_cli::launcher::{self, RunOptions};
 use swarm_contract::config::hosts::TlsFiles;
@@ -129,6 +129,14 @@ enum Commands {
         /// Do not draw a progress bar.
         #[arg(long)]
         no_progress: bool,
+        /// Run only share I of N of the grid's runs (e.g. 2/4), into <out>/shard-I-of-N unless --out is given;
+        /// combine the shards' folders afterwards with --merge.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<Shard>,
+        /// Run nothing: write one results.csv, figures and report.md (into --out, default the grid's out) from
+        /// the finished runs of these shard folders (repeatable).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["shard", "jobs"])]
+        merge: Vec<PathBuf>,
     },
 }
 
@@ -299,11 +307,15 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             out,
             jobs,
             no_progress,
+            shard,
+            merge,
         } => done(run_experiment(ExperimentOptions {
             grid,
             out,
             jobs,
             progress: !no_progress,
+            shard,
+            merge,
         })),
         Commands::Run {
             config,

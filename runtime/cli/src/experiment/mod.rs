@@ -7,7 +7,13 @@
 //! ([`results`]) -> write `results.csv`, the figures ([`plots`]) and `report.md` ([`report`]).
 //!
 //! It never simulates anything itself: each run is [`crate::launcher::run`], i.e. one world process and one agent
-//! process per robot, exactly as `swarm run`. It never counts a run that did not complete.
+//! process per robot, exactly as `swarm run`. It never counts a run that did not complete. One process at a time
+//! writes into a batch folder (it holds the folder's lock).
+//!
+//! **Shards.** `--shard i/n` runs only the i-th of n shares of the grid's runs (run k of the configurations x
+//! seeds order belongs to shard k mod n + 1) into its own folder, so n machines or jobs can share a grid.
+//! `--merge <shard folder>...` runs nothing: it reads the finished runs of the shard folders (each checked against
+//! the grid like any finished run) and writes one `results.csv`, the figures and `report.md` for the whole grid.
 
 pub mod address;
 pub mod document;
@@ -50,6 +56,48 @@ pub struct ExperimentOptions {
     pub jobs: Option<usize>,
     /// Show a progress bar.
     pub progress: bool,
+    /// Run only this share of the grid: `(i, n)`, the i-th of n (1-based).
+    pub shard: Option<Shard>,
+    /// Run nothing; summarise the finished runs of these batch folders (shards of the same grid).
+    pub merge: Vec<PathBuf>,
+}
+
+/// One of n shares of a grid's runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Which share, from 1.
+    pub index: usize,
+    /// How many shares.
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+
+    /// Parses `i/n` with 1 <= i <= n.
+    fn from_str(text: &str) -> Result<Shard, String> {
+        let parsed = text
+            .split_once('/')
+            .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)));
+        match parsed {
+            Some((index, count)) if index >= 1 && index <= count => Ok(Shard { index, count }),
+            _ => Err(format!(
+                "'{text}' is not a shard i/n with 1 <= i <= n (e.g. 2/4)"
+            )),
+        }
+    }
+}
+
+impl Shard {
+    /// Whether run number `k` (in configurations x seeds order, from 0) belongs to this shard.
+    fn owns(self, k: usize) -> bool {
+        k % self.count == self.index - 1
+    }
+
+    /// The folder name of this shard inside the grid's batch folder.
+    fn folder(self) -> String {
+        format!("shard-{}-of-{}", self.index, self.count)
+    }
 }
 
 /// What a batch did.
@@ -93,6 +141,12 @@ pub enum ExperimentError {
     /// A finished run's summary is unreadable.
     #[error(transparent)]
     Summary(#[from] results::SummaryError),
+    /// Another process writes into the batch folder.
+    #[error(transparent)]
+    Locked(#[from] swarm_contract::run_dir::RunDirError),
+    /// A folder to merge is not a batch folder.
+    #[error("{0} is not a batch folder of `swarm experiment` (it has no runs/ folder)")]
+    NotABatch(PathBuf),
 }
 
 fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> ExperimentError {
@@ -140,7 +194,16 @@ pub fn run(
 ) -> Result<BatchReport, ExperimentError> {
     let grid = Grid::load(&options.grid)?;
     let configurations = plan::configurations(&grid)?;
-    let root = options.out.clone().unwrap_or_else(|| grid.out.clone());
+    let root = match (&options.out, options.shard) {
+        (Some(out), _) => out.clone(),
+        (None, Some(shard)) => grid.out.join(shard.folder()),
+        (None, None) => grid.out.clone(),
+    };
+    // Held until the batch is summarised.
+    let _lock = swarm_contract::run_dir::lock_folder(&root)?;
+    if !options.merge.is_empty() {
+        return merge(options, &grid, &configurations, root);
+    }
     let batch = BatchDir::create(&root).map_err(io(format!("creating {}", root.display())))?;
     std::fs::write(root.join("grid.toml"), &grid.text).map_err(io("copying the grid"))?;
     for configuration in &configurations {
@@ -152,8 +215,15 @@ pub fn run(
 
     let mut tasks = VecDeque::new();
     let mut reused = 0;
+    let mut runs_planned = 0;
+    let mut k = 0;
     for (index, configuration) in configurations.iter().enumerate() {
         for &seed in &grid.seeds {
+            k += 1;
+            if options.shard.is_some_and(|shard| !shard.owns(k - 1)) {
+                continue;
+            }
+            runs_planned += 1;
             match batch.state(configuration, seed, grid.ticks) {
                 RunState::Finished => reused += 1,
                 state => {
@@ -171,7 +241,6 @@ pub fn run(
             }
         }
     }
-    let runs_planned = configurations.len() * grid.seeds.len();
     let max_robots = configurations.iter().map(|c| c.robots).max().unwrap_or(0);
     let jobs = options
         .jobs
@@ -200,7 +269,13 @@ pub fn run(
     progress.finish_and_clear();
     let interrupted = stop.load(Ordering::Relaxed);
 
-    let plots_missing = summarise(&grid, &batch, &configurations, runs_planned)?;
+    let plots_missing = summarise(
+        &grid,
+        std::slice::from_ref(&batch),
+        &root,
+        &configurations,
+        runs_planned,
+    )?;
     Ok(BatchReport {
         dir: root,
         configurations: configurations.len(),
@@ -317,26 +392,86 @@ fn run_one(
     }
 }
 
-/// Reads every finished run and writes `results.csv`, the figures and `report.md`; returns why figures are
-/// missing, if they are.
-fn summarise(
+/// `--merge`: summarises the finished runs of the shard folders into `root`.
+fn merge(
+    options: &ExperimentOptions,
+    grid: &Grid,
+    configurations: &[Configuration],
+    root: PathBuf,
+) -> Result<BatchReport, ExperimentError> {
+    let mut sources = Vec::new();
+    for dir in &options.merge {
+        if !dir.join("runs").is_dir() {
+            return Err(ExperimentError::NotABatch(dir.clone()));
+        }
+        sources.push(BatchDir::create(dir).map_err(io(format!("opening {}", dir.display())))?);
+    }
+    std::fs::write(root.join("grid.toml"), &grid.text).map_err(io("copying the grid"))?;
+    let runs_planned = configurations.len() * grid.seeds.len();
+    let plots_missing = summarise(grid, &sources, &root, configurations, runs_planned)?;
+    let found = sources
+        .iter()
+        .flat_map(|source| finished_runs(grid, source, configurations))
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    Ok(BatchReport {
+        dir: root,
+        configurations: configurations.len(),
+        runs_planned,
+        runs_reused: found,
+        runs_completed: 0,
+        failures: Vec::new(),
+        interrupted: false,
+        jobs: 0,
+        plots_missing,
+    })
+}
+
+/// The (configuration, seed) runs finished in `batch` for this grid.
+fn finished_runs(
     grid: &Grid,
     batch: &BatchDir,
     configurations: &[Configuration],
-    runs_planned: usize,
-) -> Result<Option<String>, ExperimentError> {
-    let mut runs = Vec::new();
+) -> Vec<(usize, u64)> {
+    let mut finished = Vec::new();
     for (index, configuration) in configurations.iter().enumerate() {
         for &seed in &grid.seeds {
             if batch.state(configuration, seed, grid.ticks) == RunState::Finished {
-                runs.push(RunResult::read(
-                    &batch.run_dir(&configuration.id, seed),
-                    index,
-                    seed,
-                )?);
+                finished.push((index, seed));
             }
         }
     }
+    finished
+}
+
+/// Reads every run finished in one of `sources` (the first that holds it) and writes `results.csv`, the figures
+/// and `report.md` into `root`; returns why figures are missing, if they are.
+fn summarise(
+    grid: &Grid,
+    sources: &[BatchDir],
+    root: &Path,
+    configurations: &[Configuration],
+    runs_planned: usize,
+) -> Result<Option<String>, ExperimentError> {
+    let mut runs: Vec<RunResult> = Vec::new();
+    for source in sources {
+        for (index, seed) in finished_runs(grid, source, configurations) {
+            if runs
+                .iter()
+                .any(|r| r.configuration == index && r.seed == seed)
+            {
+                continue;
+            }
+            let dir = source.run_dir(&configurations[index].id, seed);
+            runs.push(RunResult::read(&dir, index, seed)?);
+        }
+    }
+    runs.sort_by_key(|r| {
+        (
+            r.configuration,
+            grid.seeds.iter().position(|&s| s == r.seed),
+        )
+    });
     let metrics = results::metric_names(&runs);
     if !runs.is_empty() && !metrics.contains(&grid.median_metric) {
         return Err(ExperimentError::Grid(ConfigErrors {
@@ -351,7 +486,6 @@ fn summarise(
         }));
     }
     let selected = results::select_medians(configurations.len(), &runs, &grid.median_metric);
-    let root = batch.root();
     write(
         root,
         "results.csv",

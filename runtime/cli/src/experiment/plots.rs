@@ -1,6 +1,8 @@
 //! PNG figures of a batch, as the thesis draws them: each metric against the robot count, one figure per
 //! configuration family (the configurations that share every factor level except the robot factor and the line
-//! factor), one line per level of the line factor, each point the configuration's median run.
+//! factor), one line per level of the line factor, each point the configuration's median run. Each point also
+//! shows the spread over its seeds: a thin bar from the smallest to the largest run, a thick one over the middle
+//! half (first to third quartile), so a median that hides a wide spread is seen as such.
 //!
 //! Text is drawn with a TrueType font read once at run time (`SWARM_PLOT_FONT`, else a common system font), so
 //! the build needs no font library; without a font the batch still writes its table and report and says why the
@@ -29,8 +31,26 @@ const FONT_CANDIDATES: &[&str] = &[
 /// Figure size in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
-/// The (robot count, metric value) points of one line.
-type Points = Vec<(f64, f64)>;
+/// One point of a line: a configuration's median run and the spread of its runs over the seeds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Point {
+    robots: f64,
+    median: f64,
+    min: f64,
+    lower_quartile: f64,
+    upper_quartile: f64,
+    max: f64,
+}
+
+/// The points of one line.
+type Points = Vec<Point>;
+
+/// The value at quantile `q` of sorted `values` (linear between neighbours).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let at = (sorted.len() - 1) as f64 * q;
+    let (low, high) = (at.floor() as usize, at.ceil() as usize);
+    sorted[low] + (sorted[high] - sorted[low]) * (at - low as f64)
+}
 /// A family's fixed levels -> the line factor's level -> the line's points.
 type Families = BTreeMap<Vec<usize>, BTreeMap<usize, Points>>;
 
@@ -121,12 +141,22 @@ pub fn draw(
             // family levels -> line level -> (robots, value) points
             let mut families: Families = BTreeMap::new();
             for result in results {
-                let Some(value) = result
+                let Some(median) = result
                     .median_run
                     .and_then(|i| runs[i].metrics.get(metric).copied())
                 else {
                     continue;
                 };
+                let mut values: Vec<f64> = result
+                    .runs
+                    .iter()
+                    .filter_map(|&i| runs[i].metrics.get(metric).copied())
+                    .filter(|v| v.is_finite())
+                    .collect();
+                values.sort_by(f64::total_cmp);
+                if values.is_empty() {
+                    values.push(median);
+                }
                 let c = &configurations[result.configuration];
                 let family: Vec<usize> = (0..grid.factors.len())
                     .filter(|&f| Some(f) != grid.x_factor && Some(f) != line)
@@ -138,7 +168,14 @@ pub fn draw(
                     .or_default()
                     .entry(line_level)
                     .or_default()
-                    .push((f64::from(c.robots), value));
+                    .push(Point {
+                        robots: f64::from(c.robots),
+                        median,
+                        min: values[0],
+                        lower_quartile: quantile(&values, 0.25),
+                        upper_quartile: quantile(&values, 0.75),
+                        max: values[values.len() - 1],
+                    });
             }
             let family_factors: Vec<usize> = (0..grid.factors.len())
                 .filter(|&f| Some(f) != grid.x_factor && Some(f) != line)
@@ -176,7 +213,7 @@ pub fn draw(
                 let series: Vec<(String, Points)> = lines
                     .into_iter()
                     .map(|(level, mut points)| {
-                        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        points.sort_by(|a, b| a.robots.total_cmp(&b.robots));
                         let label = match line {
                             Some(f) => format!(
                                 "{} = {}",
@@ -188,9 +225,9 @@ pub fn draw(
                     })
                     .collect();
                 let title = if family_text.is_empty() {
-                    format!("{metric} (median runs)")
+                    format!("{metric}: median run, bars over seeds")
                 } else {
-                    format!("{metric} (median runs), {family_text}")
+                    format!("{metric}: median run, bars over seeds; {family_text}")
                 };
                 draw_figure(&batch.join(&relative), &title, metric, &series)?;
                 figures.push(Figure {
@@ -234,8 +271,8 @@ fn draw_figure(
         std::fs::create_dir_all(parent).map_err(|e| fail(e.to_string()))?;
     }
     let points = series.iter().flat_map(|(_, p)| p.iter());
-    let x_range = padded(points.clone().map(|p| p.0));
-    let y_range = padded(points.map(|p| p.1));
+    let x_range = padded(points.clone().map(|p| p.robots));
+    let y_range = padded(points.flat_map(|p| [p.min, p.max]));
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
     let mut chart = ChartBuilder::on(&root)
@@ -254,9 +291,26 @@ fn draw_figure(
         .map_err(|e| fail(e.to_string()))?;
     for (i, (label, points)) in series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
+        // Bars first, so the line and its points stay on top.
+        chart
+            .draw_series(points.iter().map(|p| {
+                PathElement::new(
+                    vec![(p.robots, p.min), (p.robots, p.max)],
+                    color.stroke_width(1),
+                )
+            }))
+            .map_err(|e| fail(e.to_string()))?;
+        chart
+            .draw_series(points.iter().map(|p| {
+                PathElement::new(
+                    vec![(p.robots, p.lower_quartile), (p.robots, p.upper_quartile)],
+                    color.mix(0.5).stroke_width(7),
+                )
+            }))
+            .map_err(|e| fail(e.to_string()))?;
         chart
             .draw_series(LineSeries::new(
-                points.iter().copied(),
+                points.iter().map(|p| (p.robots, p.median)),
                 color.stroke_width(2),
             ))
             .map_err(|e| fail(e.to_string()))?
@@ -265,7 +319,11 @@ fn draw_figure(
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
             });
         chart
-            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .draw_series(
+                points
+                    .iter()
+                    .map(|p| Circle::new((p.robots, p.median), 4, color.filled())),
+            )
             .map_err(|e| fail(e.to_string()))?;
     }
     chart
@@ -276,4 +334,17 @@ fn draw_figure(
         .draw()
         .map_err(|e| fail(e.to_string()))?;
     root.present().map_err(|e| fail(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn quantiles_interpolate_between_sorted_values() {
+        let values = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(super::quantile(&values, 0.0), 1.0);
+        assert_eq!(super::quantile(&values, 0.25), 2.0);
+        assert_eq!(super::quantile(&values, 0.5), 3.0);
+        assert_eq!(super::quantile(&[1.0, 2.0], 0.5), 1.5);
+        assert_eq!(super::quantile(&[7.0], 0.75), 7.0);
+    }
 }
