@@ -130,31 +130,34 @@ fn nested(open: &str, name: &str, depth: usize, close: &str) -> Vec<u8> {
     text.into_bytes()
 }
 
-/// Reads a mutant as the file `name` would be: text through the parser in memory; bytes that are not UTF-8
-/// through a real file, as `swarm run` reads them, so the refusal is the one a user sees.
-fn as_text<T, E: std::fmt::Display>(
-    dir: &Path,
-    name: &str,
-    bytes: &[u8],
-    parse: impl Fn(&Path, &str) -> Result<T, E>,
-    load: impl Fn(&Path) -> Result<T, E>,
+/// Fuzzes a text format read from files. Text goes through `parse` in memory, as if read from the corpus file
+/// (so paths relative to it resolve). Bytes that are not UTF-8 go through a real file and `load`, as `swarm`
+/// reads them, so the refusal is the one a user sees. Every refusal must name the file.
+fn fuzz_text_files<E: std::fmt::Display>(
+    corpus: &[(String, Vec<u8>)],
+    tokens: &[&[u8]],
+    parse: impl Fn(&Path, &str) -> Result<(), E>,
+    load: impl Fn(&Path) -> Result<(), E>,
 ) {
-    let file = Path::new(name).file_name().expect("a file name");
-    let result = match std::str::from_utf8(bytes) {
-        Ok(text) => parse(Path::new(name), text),
-        Err(_) => {
-            let path = dir.join(file);
-            std::fs::write(&path, bytes).expect("a temporary file");
-            load(&path)
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    fuzz(corpus, tokens, |name, bytes| {
+        let file = Path::new(name).file_name().expect("a file name");
+        let result = match std::str::from_utf8(bytes) {
+            Ok(text) => parse(Path::new(name), text),
+            Err(_) => {
+                let path = dir.path().join(file);
+                std::fs::write(&path, bytes).expect("a temporary file");
+                load(&path)
+            }
+        };
+        if let Err(e) = result {
+            let message = e.to_string();
+            assert!(
+                message.contains(&*file.to_string_lossy()),
+                "a refusal of {name} does not name the file:\n{message}"
+            );
         }
-    };
-    if let Err(e) = result {
-        let message = e.to_string();
-        assert!(
-            message.contains(&*file.to_string_lossy()),
-            "a refusal of {name} does not name the file:\n{message}"
-        );
-    }
+    });
 }
 
 #[test]
@@ -184,7 +187,6 @@ fn experiment_files_are_read_or_refused_with_their_name() {
         corpus.push((name.clone(), text.into_bytes()));
     }
     corpus.push((name.clone(), b"\xff\xfe<argos-configuration>".to_vec()));
-    let dir = tempfile::tempdir().expect("a temporary directory");
     let tokens: &[&[u8]] = &[
         b"<",
         b">",
@@ -210,15 +212,12 @@ fn experiment_files_are_read_or_refused_with_their_name() {
         b"<hosts>",
         b"\n",
     ];
-    fuzz(&corpus, tokens, |name, bytes| {
-        as_text(
-            dir.path(),
-            name,
-            bytes,
-            |path, text| Experiment::parse(path, text).map(|_| ()),
-            |path| Experiment::load(path).map(|_| ()),
-        );
-    });
+    fuzz_text_files(
+        &corpus,
+        tokens,
+        |path, text| Experiment::parse(path, text).map(|_| ()),
+        |path| Experiment::load(path).map(|_| ()),
+    );
 }
 
 #[test]
@@ -292,7 +291,6 @@ fn model_files_are_read_or_refused_with_their_name() {
 #[test]
 fn grid_files_are_read_or_refused_with_their_name() {
     let corpus = corpus_files(".toml");
-    let dir = tempfile::tempdir().expect("a temporary directory");
     let tokens: &[&[u8]] = &[
         b"[",
         b"]",
@@ -307,16 +305,12 @@ fn grid_files_are_read_or_refused_with_their_name() {
         b"{",
         b"\\u0000",
     ];
-    fuzz(&corpus, tokens, |name, bytes| {
-        // A grid names its experiments relative to itself: parse it where it lives, so they can be found.
-        as_text(
-            dir.path(),
-            name,
-            bytes,
-            |path, text| Grid::parse(path, text).map(|_| ()),
-            |path| Grid::load(path).map(|_| ()),
-        );
-    });
+    fuzz_text_files(
+        &corpus,
+        tokens,
+        |path, text| Grid::parse(path, text).map(|_| ()),
+        |path| Grid::load(path).map(|_| ()),
+    );
 }
 
 /// One message of every type that crosses the network, as sent.

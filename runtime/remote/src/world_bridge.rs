@@ -374,8 +374,16 @@ impl RemoteHosts {
                         format!("'{}' {what}", h.share.name)
                     })
                     .collect();
+                let keys = match self.options.keys {
+                    HostKeys::On(_) => {
+                        "; each needs its key from this machine (`swarm host-key <name>` says where it is): a host \
+                         with another key or none is never admitted"
+                    }
+                    HostKeys::Off => " --insecure",
+                };
                 return Err(RemoteError::HostsMissing(format!(
-                    "hosts not ready within {timeout:?}: {} (start them with `swarm host --connect {} --name <name>`)",
+                    "hosts not ready within {timeout:?}: {} (start them with `swarm host --connect {} --name \
+                     <name>`{keys})",
                     missing.join(", "),
                     self.options
                         .listen
