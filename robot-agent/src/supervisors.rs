@@ -119,9 +119,20 @@ pub fn load(files: &[PathBuf]) -> Result<SupervisorSet, SupervisorError> {
     };
     let mut texts = Vec::with_capacity(models.len());
     for file in &models {
-        let text = std::fs::read_to_string(file).map_err(|problem| SupervisorError::Io {
+        let io = |problem| SupervisorError::Io {
             path: file.clone(),
             problem,
+        };
+        // The same limits as `supervisor-gen`: a device or FIFO named as a model must not hang the agent.
+        let bytes = swarm_contract::supervisor_gen::load::read_limited(file).map_err(io)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "not valid UTF-8 at byte {} (model files must be UTF-8)",
+                    e.utf8_error().valid_up_to()
+                ),
+            ))
         })?;
         texts.push((file.display().to_string(), text));
     }
@@ -245,5 +256,16 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("/nonexistent/oa.sup"), "{err}");
+    }
+
+    #[test]
+    fn a_device_named_as_a_model_or_compiled_set_is_refused_before_it_is_read() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let model = dir.path().join("zero.xml");
+        std::os::unix::fs::symlink("/dev/zero", &model).expect("a symbolic link");
+        for files in [vec![model], vec![PathBuf::from("/dev/zero")]] {
+            let err = load(&files).unwrap_err().to_string();
+            assert!(err.contains("not a regular file"), "{err}");
+        }
     }
 }

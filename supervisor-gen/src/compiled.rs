@@ -505,7 +505,7 @@ impl SupervisorSet {
 
     /// Reads and validates a compiled set from a file; errors name the file.
     pub fn read(path: &Path) -> Result<Self, CompiledFormatError> {
-        let bytes = std::fs::read(path).map_err(|source| CompiledFormatError::Io {
+        let bytes = crate::load::read_limited(path).map_err(|source| CompiledFormatError::Io {
             path: path.to_owned(),
             source,
         })?;

@@ -74,9 +74,9 @@ pub fn load(inputs: &[Input], options: ValidateOptions) -> Result<Validation, Lo
 /// such as `/dev/zero`) can take.
 pub const MAX_MODEL_BYTES: u64 = 512 * 1024 * 1024;
 
-/// The bytes of a regular file of at most [`MAX_MODEL_BYTES`]; a FIFO, a device or a folder is refused before it
-/// is read (a FIFO would block forever).
-fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
+/// The bytes of a model or compiled supervisor file: a regular file of at most [`MAX_MODEL_BYTES`]; a FIFO, a
+/// device or a folder is refused before it is read (a FIFO would block forever, a device never end).
+pub fn read_limited(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let refuse = |message: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, message);
     let metadata = std::fs::metadata(path)?;
