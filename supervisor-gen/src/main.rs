@@ -31,7 +31,12 @@ use supervisor_gen::xml_write::to_xml;
 /// (`<model type="FSA">`), told apart by their root element.
 /// Exit codes: 0 success, 1 invalid input or impossible specification, 2 usage or I/O error.
 #[derive(Debug, Parser)]
-#[command(name = "supervisor-gen", version)]
+#[command(
+    name = "supervisor-gen",
+    version,
+    after_help = "The model format, every attribute and every diagnostic code: docs/models.md. The theory the \
+                  tool follows: docs/ptsct.md."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

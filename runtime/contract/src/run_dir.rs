@@ -1,10 +1,11 @@
 //! The run directory: everything a run leaves behind, and the one place that names its files.
 //!
-//! `summary.json`, `trajectory.csv`, `events.csv` and `snapshot_<tick>.png` are written by the world; the launcher
-//! adds `config.argos` (the configuration as used), `logs/` (one log per agent, kept so a failed start can be
-//! explained), `supervisors/` (each controller's compiled supervisor set), `event_tables.json`, `resume/` (the
-//! resume points of restarted agents), `control.sock` (`swarm ctl`) and its own fields in `summary.json`. A batch
-//! of `swarm experiment` marks each finished run with `run.json`. Every process takes these names from here.
+//! `summary.json`, `trajectory.csv`, `events.csv`, `snapshot_<tick>.png` and `resume/` (the resume point of every
+//! robot the world marks down, for its replacement if one is started) are written by the world; the launcher adds
+//! `config.argos` (the configuration as run), `logs/` (one log per local agent, kept so a failed start can be
+//! explained), `supervisors/` (each controller's compiled supervisor set), `event_tables.json`, `control.sock`
+//! (`swarm ctl`) and its own fields in `summary.json`. A batch of `swarm experiment` marks each finished run with
+//! `run.json`. Every process takes these names from here; docs/records.md describes every file and column.
 
 use std::fs::File;
 use std::io::Write;
@@ -25,7 +26,7 @@ pub const CONFIG_COPY_FILE: &str = "config.argos";
 pub const LOGS_DIR: &str = "logs";
 /// Folder holding each controller's compiled supervisor set.
 pub const COMPILED_SUPERVISORS_DIR: &str = "supervisors";
-/// Folder of the resume points of restarted agents.
+/// Folder of the resume points of robots the world marked down (read by their replacements).
 pub const RESUME_DIR: &str = "resume";
 /// The launcher's control socket (`swarm ctl`).
 pub const CONTROL_SOCKET: &str = "control.sock";

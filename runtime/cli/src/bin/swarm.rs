@@ -35,7 +35,13 @@ use swarm_remote::session::{DEFAULT_LEASE, ZenohOptions};
 
 /// Runs swarms of robot processes executing ptSCT supervisors.
 #[derive(Debug, Parser)]
-#[command(name = "swarm", version, about)]
+#[command(
+    name = "swarm",
+    version,
+    about,
+    after_help = "Documents (in the repository's docs/): configuration.md (the .argos file), records.md (what a run \
+                  writes), faults.md, hosts.md, experiments.md, models.md (the model XML) and ptsct.md."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Commands,

@@ -17,9 +17,9 @@ pub struct RestartRecord {
 /// One fault of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaultRecord {
-    /// What happened: `kill`, `freeze`, `thaw`, `kill-world` (scheduled), `ctl-kill`, `ctl-freeze`, `ctl-thaw`
-    /// (`swarm ctl`), `exit` (an agent ended by itself or by someone else's signal), `deadline` (the world saw
-    /// a robot miss a tick's deadline).
+    /// What happened: `kill`, `freeze`, `thaw`, `kill-world` (scheduled), `ctl-kill`, `ctl-freeze`, `ctl-thaw`,
+    /// `ctl-kill-host` (`swarm ctl`), `exit` (an agent ended by itself or by someone else's signal), `deadline`
+    /// (the world saw a robot miss a tick's deadline), `host-lost` (the robot's host was lost).
     pub what: String,
     /// The robot, or `None` for the world.
     pub robot: Option<u32>,
