@@ -1,7 +1,9 @@
 //! Graphviz drawings of models, products and supervisors with the conventions of docs/ptsct.md section 1: controllable
 //! arcs single black lines, uncontrollable arcs red double lines, marked states double circles, an entry arrow on the
 //! initial state, bad states filled red and otherwise removed states outlined in dashed red. Controllable labels show
-//! P (when not 1) and T (when not 0).
+//! P (when not 1) and T (when not 0) on the same line as their event, `a [P=0.8 T=2]`, so that when Graphviz stacks
+//! the labels of several self-loops every probability stays next to the event it belongs to. Every drawing carries
+//! a small legend of these conventions.
 //!
 //! DOT text is always produced. SVG and PNG are rendered only when the `dot` program is on PATH; its absence is
 //! logged once and is not an error.
@@ -88,9 +90,26 @@ pub fn to_dot(
             );
         }
     }
+    out.push_str(LEGEND);
     out.push_str("}\n");
     out
 }
+
+/// The legend drawn in a corner of every drawing: what colours, lines, shapes, P and T mean.
+const LEGEND: &str = concat!(
+    "  subgraph cluster_legend {\n",
+    "    label=\"legend\"; fontsize=10; style=dashed; color=gray;\n",
+    "    node [shape=plaintext, fontsize=9, width=0, height=0, margin=0.02];\n",
+    "    __legend [label=<<table border=\"0\" cellspacing=\"1\">",
+    "<tr><td align=\"left\">black arc: controllable event</td></tr>",
+    "<tr><td align=\"left\"><font color=\"red\">red double arc: uncontrollable event</font></td></tr>",
+    "<tr><td align=\"left\">double circle: marked state</td></tr>",
+    "<tr><td align=\"left\">e [P=p]: probability of e among the state's enabled controllable events</td></tr>",
+    "<tr><td align=\"left\">e [T=n]: lower time bound: e only after n ticks (docs/ptsct.md)</td></tr>",
+    "<tr><td align=\"left\"><font color=\"red\">red fill: bad state; dashed red: removed state</font></td></tr>",
+    "</table>>];\n",
+    "  }\n",
+);
 
 /// Label and style of one arc.
 fn edge_attrs(t: &Transition, events: &EventTable, probs: ProbLabels, weight_sum: f64) -> String {
@@ -112,7 +131,7 @@ fn edge_attrs(t: &Transition, events: &EventTable, probs: ProbLabels, weight_sum
         extras.push(format!("T={}", t.lower_bound));
     }
     if !extras.is_empty() {
-        let _ = write!(label, "\\n{}", extras.join(" "));
+        let _ = write!(label, " [{}]", extras.join(" "));
     }
     format!("label=\"{label}\"")
 }
@@ -207,6 +226,9 @@ pub fn write_drawing(
     images: &Images,
 ) -> io::Result<Vec<PathBuf>> {
     let dot_path = dir.join(format!("{stem}.dot"));
+    if let Some(parent) = dot_path.parent() {
+        std::fs::create_dir_all(parent)?;
+    }
     std::fs::write(&dot_path, dot)?;
     let mut written = vec![dot_path.clone()];
     if images.formats.is_empty() || !graphviz_available() {
@@ -281,7 +303,7 @@ mod tests {
             "uncontrollable arcs are red double lines"
         );
         assert!(
-            dot.contains("s0 -> s1 [label=\"a\\nP=0.8 T=2\"];"),
+            dot.contains("s0 -> s1 [label=\"a [P=0.8 T=2]\"];"),
             "controllable labels show P and T"
         );
         assert!(
@@ -302,8 +324,9 @@ mod tests {
     fn input_weights_are_shown_normalised_per_state() {
         let (g, events) = example();
         let dot = to_dot(&g, &events, &HashMap::new(), ProbLabels::PerState);
-        assert!(dot.contains("s2 -> s0 [label=\"b\\nP=0.25\"];"));
-        assert!(dot.contains("s2 -> s1 [label=\"c\\nP=0.75\"];"));
+        assert!(dot.contains("s2 -> s0 [label=\"b [P=0.25]\"];"));
+        assert!(dot.contains("s2 -> s1 [label=\"c [P=0.75]\"];"));
+        assert!(dot.contains("cluster_legend"), "every drawing has a legend");
     }
 
     #[test]

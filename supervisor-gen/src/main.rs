@@ -447,11 +447,12 @@ fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
     println!("MemCons {mem_cons} bytes; outputs in {}", out.display());
 }
 
-/// Draws the project's inputs (once) and every stage of every supervisor.
+/// Draws the project's inputs (once, into `inputs/`), every intermediate stage of every supervisor (into
+/// `stages/`) and the final supervisors (at the top, apart from the rest).
 fn draw_synthesis(drawer: &Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
     let project = &synthesis.normalised;
     for a in project.plants.iter().chain(&project.specs) {
-        let stem = format!("input_{}", dot::file_stem(a.name()));
+        let stem = format!("inputs/{}", dot::file_stem(a.name()));
         drawer.draw(&stem, a, &HashMap::new(), ProbLabels::Stored)?;
     }
     for s in synthesis
@@ -481,16 +482,16 @@ fn draw_stages(drawer: &Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
         ("2_E", &s.spec, &none),
         ("3_K", &s.target, &removed),
         ("4_supc", &s.unminimised, &none),
-        ("5_final", &s.supervisor, &none),
     ];
     for (stage, automaton, marks) in stages {
         drawer.draw(
-            &format!("{stem}_{stage}"),
+            &format!("stages/{stem}_{stage}"),
             automaton,
             marks,
             ProbLabels::Stored,
         )?;
     }
+    drawer.draw(&stem, &s.supervisor, &none, ProbLabels::Stored)?;
     Ok(())
 }
 

@@ -116,13 +116,13 @@ fn synth_monolithic_with_draw_writes_every_stage_and_images_only_with_graphviz()
     assert!(dir.path().join("S_mon.xml").is_file());
     let drawings = dir.path().join("drawings");
     for stem in [
-        "input_machine1",
-        "input_buffer",
-        "S_mon_1_G",
-        "S_mon_2_E",
-        "S_mon_3_K",
-        "S_mon_4_supc",
-        "S_mon_5_final",
+        "inputs/machine1",
+        "inputs/buffer",
+        "stages/S_mon_1_G",
+        "stages/S_mon_2_E",
+        "stages/S_mon_3_K",
+        "stages/S_mon_4_supc",
+        "S_mon",
     ] {
         assert!(drawings.join(format!("{stem}.dot")).is_file(), "{stem}.dot");
         assert_eq!(
@@ -136,7 +136,7 @@ fn synth_monolithic_with_draw_writes_every_stage_and_images_only_with_graphviz()
             "{stem}.png"
         );
     }
-    let k = std::fs::read_to_string(drawings.join("S_mon_3_K.dot")).expect("K drawn");
+    let k = std::fs::read_to_string(drawings.join("stages/S_mon_3_K.dot")).expect("K drawn");
     assert!(
         k.contains("fillcolor=\"#ff9999\""),
         "bad states of K are drawn red"
@@ -271,7 +271,7 @@ fn draw_writes_one_drawing_per_model() {
     let dot = std::fs::read_to_string(dir.path().join("example.dot")).expect("drawn");
     // Input weights are shown normalised per state: 1 and 3 at q2 become 0.25 and 0.75.
     assert!(
-        dot.contains("label=\"b\\nP=0.25\"") && dot.contains("label=\"c\\nP=0.75\""),
+        dot.contains("label=\"b [P=0.25]\"") && dot.contains("label=\"c [P=0.75]\""),
         "{dot}"
     );
 }
@@ -366,7 +366,8 @@ fn without_graphviz_only_dot_is_written_and_the_absence_is_logged_once() {
         stderr(&o)
     );
     let drawings = dir.path().join("drawings");
-    assert!(drawings.join("S_buffer_3_K.dot").is_file());
+    assert!(drawings.join("stages/S_buffer_3_K.dot").is_file());
+    assert!(drawings.join("S_buffer.dot").is_file());
     let images = std::fs::read_dir(&drawings)
         .expect("drawings dir")
         .filter_map(Result::ok)
