@@ -6,6 +6,7 @@ pub mod aggregation;
 pub mod foraging;
 pub mod obstacle_avoidance;
 pub mod pheromone_foraging;
+pub mod phototaxis;
 pub mod synchronisation;
 pub mod timer;
 
@@ -22,6 +23,7 @@ use aggregation::Aggregation;
 use foraging::Forager;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
 use pheromone_foraging::PheromoneForager;
+use phototaxis::Phototaxis;
 use synchronisation::{Synchronisation, SynchronisationSct};
 
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
@@ -51,6 +53,7 @@ const PROFILES: &[(&str, BindFn)] = &[
     (SynchronisationSct::NAME, bind_boxed::<SynchronisationSct>),
     (Forager::NAME, bind_boxed::<Forager>),
     (PheromoneForager::NAME, bind_boxed::<PheromoneForager>),
+    (Phototaxis::NAME, bind_boxed::<Phototaxis>),
 ];
 
 /// Why a profile could not be set up.

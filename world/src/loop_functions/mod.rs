@@ -8,6 +8,7 @@ pub mod foraging;
 pub mod obstacle_avoidance;
 pub mod params;
 pub mod pheromone_foraging;
+pub mod phototaxis;
 pub mod synchronisation;
 
 use std::collections::BTreeMap;
@@ -71,7 +72,8 @@ pub struct LoopFunctionsRegistry {
 
 impl Default for LoopFunctionsRegistry {
     /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
-    /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`.
+    /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`,
+    /// `phototaxis_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -90,6 +92,7 @@ impl Default for LoopFunctionsRegistry {
             pheromone_foraging::LABEL,
             pheromone_foraging::PheromoneForaging::factory,
         );
+        registry.register(phototaxis::LABEL, phototaxis::Phototaxis::factory);
         registry
     }
 }
