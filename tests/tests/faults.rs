@@ -70,15 +70,17 @@ fn trajectory(out: &Path) -> Vec<(u64, usize, bool, u32)> {
         .enumerate()
         .map(|(i, line)| {
             let fields: Vec<&str> = line.split(',').collect();
-            assert_eq!(fields.len(), 9, "a complete row: {line}");
-            let led: u32 = fields[5..8]
+            assert_eq!(fields.len(), 10, "a complete row: {line}");
+            let led: u32 = fields[6..9]
                 .iter()
                 .map(|v| v.parse::<u32>().expect("LED"))
                 .sum();
+            let robot: usize = fields[1].parse().expect("robot index");
+            assert_eq!(robot, i % ROBOTS, "robots in index order within a tick");
             (
                 fields[0].parse().expect("tick"),
-                i % ROBOTS,
-                fields[8] == "1",
+                robot,
+                fields[9] == "1",
                 led,
             )
         })

@@ -138,7 +138,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis)"
         );
     }
 

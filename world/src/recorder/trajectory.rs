@@ -1,5 +1,6 @@
-//! `trajectory.csv`: `tick,robot,x,y,heading,led_r,led_g,led_b,alive`, one row per robot per recorded tick,
-//! positions in metres and headings in radians, `robot` being the id from the configuration.
+//! `trajectory.csv`: `tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive`, one row per robot per recorded
+//! tick, positions in metres and headings in radians in (-pi, pi]. As in `events.csv`, `robot` is the robot's index
+//! (the number `--fault`, `swarm ctl` and `summary.json` use) and `robot_id` its id from the configuration.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -12,7 +13,7 @@ use crate::arena::Arena;
 use crate::error::WorldError;
 
 /// The header line.
-pub const TRAJECTORY_HEADER: &str = "tick,robot,x,y,heading,led_r,led_g,led_b,alive";
+pub const TRAJECTORY_HEADER: &str = "tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive";
 
 /// One robot's row of one tick, before formatting.
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +45,13 @@ impl PoseRow {
             })
             .for_each(rows);
     }
+}
+
+/// `angle` in (-pi, pi]: placed robots keep the orientation the configuration gave them until physics moves them.
+fn wrapped(angle: f32) -> f32 {
+    use std::f32::consts::{PI, TAU};
+    let a = angle.rem_euclid(TAU);
+    if a > PI { a - TAU } else { a }
 }
 
 /// A buffered trajectory file.
@@ -94,14 +102,38 @@ impl TrajectoryWriter {
             .map_or("", String::as_str);
         CsvLine::new(&mut self.out)
             .int(row.tick)?
+            .int(row.robot)?
             .text(name)?
             .float(row.x)?
             .float(row.y)?
-            .float(row.heading)?
+            .float(wrapped(row.heading))?
             .int(row.led.r)?
             .int(row.led.g)?
             .int(row.led.b)?
             .int(u8::from(row.alive))?
             .end()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrapped;
+    use std::f32::consts::PI;
+
+    #[test]
+    fn headings_are_written_in_minus_pi_to_pi() {
+        for (angle, expected) in [
+            (0.0, 0.0),
+            (PI, PI),
+            (-PI, PI),
+            (1.5 * PI, -0.5 * PI),
+            (-6.807, -0.5239),
+        ] {
+            assert!(
+                (wrapped(angle) - expected).abs() < 1e-3,
+                "{angle} -> {}",
+                wrapped(angle)
+            );
+        }
     }
 }

@@ -39,14 +39,18 @@ fn same_config_and_seed_give_bit_identical_trajectories_and_another_seed_does_no
     let text = String::from_utf8(a).expect("utf-8");
     assert_eq!(
         text.lines().next(),
-        Some("tick,robot,x,y,heading,led_r,led_g,led_b,alive")
+        Some("tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive")
     );
     assert_eq!(
         text.lines().count(),
         1 + 40 * 201,
         "a header and 40 rows for ticks 0..=200"
     );
-    assert!(text.lines().nth(1).is_some_and(|l| l.starts_with("0,fb0,")));
+    assert!(
+        text.lines()
+            .nth(1)
+            .is_some_and(|l| l.starts_with("0,0,fb0,"))
+    );
 }
 
 #[test]

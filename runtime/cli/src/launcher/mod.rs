@@ -781,7 +781,15 @@ impl Supervision {
         let mut exits = std::mem::take(&mut self.reaped);
         exits.extend(self.children.reap_agents());
         for (robot, status) in exits {
-            if self.first_tick.is_none() && !self.robots[robot as usize].ctl_killed {
+            // Agents exit 0 when the world has ended the run (its reports, even that of the first tick, may still
+            // be queued), and when they are asked to stop (SIGTERM): that robot leaves the run, and only `always`
+            // restarts it.
+            let left_with_the_run =
+                status.success() && (self.interrupted || transport::run_ended(&self.run));
+            if self.first_tick.is_none()
+                && !left_with_the_run
+                && !self.robots[robot as usize].ctl_killed
+            {
                 let log =
                     run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
                 return Err(LaunchError::AgentFailed {
@@ -795,9 +803,7 @@ impl Supervision {
                     log,
                 });
             }
-            // Agents exit 0 when the world has ended the run (its `finished` report may still be queued), and
-            // when they are asked to stop (SIGTERM): that robot leaves the run, and only `always` restarts it.
-            if status.success() && (self.interrupted || transport::run_ended(&self.run)) {
+            if left_with_the_run {
                 continue;
             }
             if status.success() {

@@ -58,10 +58,10 @@ mod tests {
     #[test]
     fn a_half_written_tick_is_cut_from_both_records() {
         let dir = tempfile::tempdir().expect("temp dir");
-        let header = "tick,robot,x,y,heading,led_r,led_g,led_b,alive\n";
+        let header = "tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive\n";
         std::fs::write(
             dir.path().join("trajectory.csv"),
-            format!("{header}0,a,0,0,0,0,0,0,1\n0,b,0,0,0,0,0,0,1\n1,a,0,0,0,0,0,0,1\n1,b,0,0,0,0,0,0,1\n2,a,0,0,0,0,0,0,1\n2,b,0,0"),
+            format!("{header}0,0,a,0,0,0,0,0,0,1\n0,1,b,0,0,0,0,0,0,1\n1,0,a,0,0,0,0,0,0,1\n1,1,b,0,0,0,0,0,0,1\n2,0,a,0,0,0,0,0,0,1\n2,1,b,0,0"),
         )
         .expect("written");
         std::fs::write(
@@ -75,7 +75,7 @@ mod tests {
         );
         let trajectory = std::fs::read_to_string(dir.path().join("trajectory.csv")).expect("read");
         assert_eq!(trajectory.lines().count(), 5);
-        assert!(trajectory.ends_with("1,b,0,0,0,0,0,0,1\n"));
+        assert!(trajectory.ends_with("1,1,b,0,0,0,0,0,0,1\n"));
         let events = std::fs::read_to_string(dir.path().join("events.csv")).expect("read");
         assert_eq!(events, "tick,robot,robot_id,event\n1,0,a,Go\n");
     }
