@@ -35,7 +35,7 @@ use supervisor_gen::xml_write::to_xml;
     name = "supervisor-gen",
     version,
     after_help = "The model format, every attribute and every diagnostic code: docs/models.md. The theory the \
-                  tool follows: docs/ptsct.md."
+                  tool follows: docs/ptsct.md. A first task from models to a running swarm: docs/tutorial.md."
 )]
 struct Cli {
     #[command(subcommand)]

@@ -39,8 +39,9 @@ use swarm_remote::session::{DEFAULT_LEASE, ZenohOptions};
     name = "swarm",
     version,
     about,
-    after_help = "Documents (in the repository's docs/): configuration.md (the .argos file), records.md (what a run \
-                  writes), faults.md, hosts.md, experiments.md, models.md (the model XML) and ptsct.md."
+    after_help = "Documents (in the repository's docs/): tutorial.md (start here), configuration.md (the .argos \
+                  file), records.md (what a run writes), controllers.md (your own profiles and loop functions), \
+                  faults.md, hosts.md, experiments.md, models.md (the model XML) and ptsct.md."
 )]
 struct Cli {
     #[command(subcommand)]
