@@ -1,5 +1,6 @@
 //! docs/tutorial.md cannot rot: every file it shows must be the repository's (whole files equal, Rust excerpts
-//! contained), and every command it gives runs in a scratch folder built from the files it shows.
+//! contained), and every command it gives runs in a scratch folder built from the files it shows. The code that
+//! docs/controllers.md quotes from the worked example must be in the files it names, too.
 //!
 //! A fenced block whose info string names a path (```` ```xml configs/phototaxis/phototaxis.argos ````) is a file:
 //! the test compares it with the repository and writes it into the scratch folder (Rust code is compared only).
@@ -155,6 +156,27 @@ fn every_file_of_the_tutorial_is_the_repositorys_and_every_command_runs() {
         assert!(
             scratch.path().join(made).is_file(),
             "the tutorial made {made}"
+        );
+    }
+}
+
+#[test]
+fn the_controller_guide_quotes_the_repositorys_code() {
+    let page = std::fs::read_to_string(workspace_file("docs/controllers.md"))
+        .expect("docs/controllers.md");
+    let quoted: Vec<Block> = blocks(&page)
+        .into_iter()
+        .filter(|b| b.path.is_some())
+        .collect();
+    assert!(quoted.len() >= 4, "the guide quotes the worked example");
+    for block in quoted {
+        let path = block.path.as_deref().unwrap_or_default();
+        let file = std::fs::read_to_string(workspace_file(path))
+            .unwrap_or_else(|e| panic!("docs/controllers.md:{} names {path}: {e}", block.line));
+        assert!(
+            file.contains(block.text.trim_end()),
+            "docs/controllers.md:{}: the code shown is not in {path}",
+            block.line
         );
     }
 }
