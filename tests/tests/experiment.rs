@@ -309,3 +309,33 @@ fn a_batch_folder_has_one_writer() {
         "the refused batch touched the folder"
     );
 }
+
+#[test]
+fn a_grid_runs_from_its_own_folder() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for name in ["phototaxis.argos", "grid.toml"] {
+        std::fs::copy(
+            workspace_file(&format!("configs/phototaxis/{name}")),
+            dir.path().join(name),
+        )
+        .expect("a copy");
+    }
+    let models = dir.path().join("models");
+    std::fs::create_dir(&models).expect("a models folder");
+    for model in std::fs::read_dir(workspace_file("configs/phototaxis/models")).expect("models") {
+        let model = model.expect("a model").path();
+        std::fs::copy(&model, models.join(model.file_name().expect("a name"))).expect("a copy");
+    }
+    let output = Command::new(bin_dir().join("swarm"))
+        .args(["experiment", "grid.toml", "--no-progress", "--out", "batch"])
+        .current_dir(dir.path())
+        .env("SWARM_BIN_DIR", bin_dir())
+        .output()
+        .expect("swarm experiment starts");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(dir.path().join("batch/results.csv").is_file());
+}

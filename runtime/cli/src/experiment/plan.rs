@@ -49,7 +49,13 @@ pub fn configurations(grid: &Grid) -> Result<Vec<Configuration>, ConfigErrors> {
     let known_warnings: BTreeSet<String> = base_warnings.iter().map(message_of).collect();
     let document =
         Document::parse(&base_text).map_err(|e| fail(format!("{}: {e}", grid.base.display())))?;
-    let base_dir = std::path::absolute(grid.base.parent().unwrap_or_else(|| Path::new("")))
+    // A base named without a folder (a grid run from its own folder) lies in the current one.
+    let base_folder = grid
+        .base
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or_else(|| Path::new("."));
+    let base_dir = std::path::absolute(base_folder)
         .map_err(|e| fail(format!("cannot resolve {}: {e}", grid.base.display())))?;
 
     let mut errors: BTreeMap<String, Diagnostic> = BTreeMap::new();
