@@ -5,7 +5,7 @@ use serde_json::json;
 use crate::arena::Arena;
 use crate::loop_functions::LoopFunctions;
 
-/// No hooks; metrics are the ticks run and the body contacts per robot.
+/// No hooks; metrics are the ticks run and the body contacts started, summed over the robots.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DefaultLoopFunctions;
 
