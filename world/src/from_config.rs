@@ -134,6 +134,7 @@ pub fn loop_functions_params(exp: &Experiment, lf: &config::LoopFunctions) -> Lo
         label: lf.label.clone(),
         location: locate(exp, lf.location),
         attributes,
+        children: lf.params.children.iter().map(|c| c.name.clone()).collect(),
     }
 }
 

@@ -388,6 +388,7 @@ mod tests {
                 .iter()
                 .map(|&(k, v)| (k.to_owned(), v.to_owned()))
                 .collect(),
+            ..LoopFunctionsParams::default()
         }
     }
 

@@ -85,23 +85,18 @@ impl ForagingParams {
             location: params.location.clone(),
             message,
         };
+        let known: Vec<&str> = std::iter::once("foraging")
+            .chain(extra_children.iter().copied())
+            .collect();
+        params.check_children(&known)?;
         let mut p = Self::default();
         for (key, value) in &params.attributes {
             let Some((child, attr)) = key.split_once('.') else {
                 continue;
             };
+            // Other children are the caller's (checked above).
             if child != "foraging" {
-                if extra_children.contains(&child) {
-                    continue;
-                }
-                return Err(invalid(format!(
-                    "<{}> does not know child <{child}> (expected <foraging>{})",
-                    params.label,
-                    extra_children
-                        .iter()
-                        .map(|c| format!(", <{c}>"))
-                        .collect::<String>()
-                )));
+                continue;
             }
             let number = || {
                 value
@@ -474,7 +469,22 @@ mod tests {
                 .iter()
                 .map(|&(k, v)| (k.to_owned(), v.to_owned()))
                 .collect::<BTreeMap<_, _>>(),
+            ..LoopFunctionsParams::default()
         }
+    }
+
+    #[test]
+    fn a_misspelt_child_is_refused_and_a_callers_child_is_not() {
+        let err = ForagingParams::parse(&params(&[("foragin.ef", "1")]), &[])
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            err.contains("has no child <foragin> (known: <foraging>)"),
+            "{err}"
+        );
+        assert!(
+            ForagingParams::parse(&params(&[("trails.food_channel", "0")]), &["trails"]).is_ok()
+        );
     }
 
     #[test]

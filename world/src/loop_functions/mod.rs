@@ -58,6 +58,46 @@ pub struct LoopFunctionsParams {
     /// Attributes of the element's children, flattened as `child.attribute` -> value
     /// (e.g. `foraging.home_y_max` -> `-2.0`).
     pub attributes: BTreeMap<String, String>,
+    /// The names of the element's children, in file order (a child without attributes is only here).
+    pub children: Vec<String>,
+}
+
+impl LoopFunctionsParams {
+    /// Refuses a child element other than `known` (a misspelt one would otherwise be ignored silently).
+    pub fn check_children(&self, known: &[&str]) -> Result<(), WorldError> {
+        let from_attributes = self
+            .attributes
+            .keys()
+            .filter_map(|k| k.split_once('.').map(|(c, _)| c));
+        match self
+            .children
+            .iter()
+            .map(String::as_str)
+            .chain(from_attributes)
+            .find(|child| !known.contains(child))
+        {
+            None => Ok(()),
+            Some(child) => Err(WorldError::Invalid {
+                location: self.location.clone(),
+                message: format!(
+                    "<loop_functions label=\"{}\"> has no child <{child}> ({})",
+                    self.label,
+                    if known.is_empty() {
+                        "it takes none".to_owned()
+                    } else {
+                        format!(
+                            "known: {}",
+                            known
+                                .iter()
+                                .map(|c| format!("<{c}>"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    }
+                ),
+            }),
+        }
+    }
 }
 
 /// Makes the loop functions of one label from the configuration.

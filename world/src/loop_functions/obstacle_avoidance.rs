@@ -22,8 +22,9 @@ pub struct ObstacleAvoidance {
 }
 
 impl ObstacleAvoidance {
-    /// The factory registered under [`LABEL`]; it takes no parameters.
-    pub fn factory(_params: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
+    /// The factory registered under [`LABEL`]; it takes no parameters (a child element is refused).
+    pub fn factory(params: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
+        params.check_children(&[])?;
         Ok(Box::new(Self::default()))
     }
 }

@@ -14,12 +14,14 @@ pub struct ParamReader<'a> {
 }
 
 impl<'a> ParamReader<'a> {
-    /// A reader of `<element ...>` inside `params`; any attribute of it not in `known` is an error.
+    /// A reader of `<element ...>` inside `params`; any attribute of it not in `known`, and any other child
+    /// element, is an error.
     pub fn new(
         params: &'a LoopFunctionsParams,
         element: &'static str,
         known: &[&str],
     ) -> Result<Self, WorldError> {
+        params.check_children(&[element])?;
         let prefix = format!("{element}.");
         for key in params.attributes.keys() {
             if let Some(name) = key.strip_prefix(&prefix)
@@ -111,6 +113,7 @@ mod tests {
                 .iter()
                 .map(|&(k, v)| (k.to_owned(), v.to_owned()))
                 .collect(),
+            ..LoopFunctionsParams::default()
         }
     }
 
@@ -123,9 +126,19 @@ mod tests {
     }
 
     #[test]
-    fn attributes_of_other_elements_are_not_checked() {
-        let p = params(&[("other.b", "1")]);
-        assert!(ParamReader::new(&p, "task", &["a"]).is_ok());
+    fn another_child_element_is_refused_even_without_attributes() {
+        let err = ParamReader::new(&params(&[("tsak.a", "1")]), "task", &["a"])
+            .expect_err("refused")
+            .to_string();
+        assert_eq!(
+            err,
+            "e.argos:3:5: <loop_functions label=\"x\"> has no child <tsak> (known: <task>)"
+        );
+        let bare = LoopFunctionsParams {
+            children: vec!["tsak".into()],
+            ..params(&[])
+        };
+        assert!(ParamReader::new(&bare, "task", &["a"]).is_err());
     }
 
     #[test]

@@ -111,6 +111,7 @@ mod tests {
             label: LABEL.into(),
             location: "exp.argos:3:5".into(),
             attributes: [("phototaxis.reach".to_owned(), "1".to_owned())].into(),
+            ..LoopFunctionsParams::default()
         };
         let err = Phototaxis::factory(&params)
             .err()

@@ -378,6 +378,7 @@ mod tests {
             attributes: [("synchronisation.window".to_owned(), "0".to_owned())]
                 .into_iter()
                 .collect(),
+            ..LoopFunctionsParams::default()
         };
         let err = Synchronisation::factory(&params).err().unwrap();
         assert_eq!(
