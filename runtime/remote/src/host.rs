@@ -290,10 +290,7 @@ fn authentic_assignment(
     query: &Query,
     served: &[(u64, u32)],
 ) -> Result<Assignment, Refusal> {
-    let bytes = query
-        .payload()
-        .map(|p| p.to_bytes().into_owned())
-        .unwrap_or_default();
+    let bytes = request_bytes(query);
     let payload = options
         .seal
         .open(&keys::assign(&options.name), &bytes)
@@ -332,6 +329,14 @@ fn authentic_assignment(
     Ok(assignment)
 }
 
+/// The bytes a query carries (none: empty, which no check accepts).
+fn request_bytes(query: &Query) -> Vec<u8> {
+    query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default()
+}
+
 /// Remembers a served (run, epoch), forgetting the oldest beyond [`SERVED_REMEMBERED`].
 fn remember(served: &mut Vec<(u64, u32)>, assignment: &Assignment) {
     if served.len() >= SERVED_REMEMBERED {
@@ -342,10 +347,7 @@ fn remember(served: &mut Vec<(u64, u32)>, assignment: &Assignment) {
 
 /// Answers `query` with `message`, tagged for the request it answers.
 fn answer<T: bincode::Encode>(query: &Query, seal: &Seal, message: &T, what: &str) {
-    let request = query
-        .payload()
-        .map(|p| p.to_bytes().into_owned())
-        .unwrap_or_default();
+    let request = request_bytes(query);
     let channel = answer_channel(query.key_expr().as_str(), &request);
     match codec::encode_message(message) {
         Ok(mut bytes) => {
@@ -383,10 +385,7 @@ fn accept(
 /// Answers a fault order: carried out by the current share if the order is authentic, for it, and newer than
 /// every order it carried out (a replayed order is refused); refused otherwise.
 fn answer_order(query: &Query, share: Option<&mut Share>, options: &HostOptions) {
-    let bytes = query
-        .payload()
-        .map(|p| p.to_bytes().into_owned())
-        .unwrap_or_default();
+    let bytes = request_bytes(query);
     let order = match options.seal.open(&keys::orders(&options.name), &bytes) {
         Ok(payload) => codec::decode_message::<Order>(payload, options.max_payload),
         Err(e) => {

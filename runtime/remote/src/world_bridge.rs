@@ -221,15 +221,26 @@ impl RemoteHosts {
         robots: u32,
         run: u64,
     ) -> Result<RemoteHosts, RemoteError> {
-        let mut seals = HashMap::new();
+        let mut host_seals = Vec::with_capacity(options.hosts.len());
         for host in &options.hosts {
             swarm_contract::config::hosts::check_host_name(&host.name)?;
             let seal = options
                 .keys
                 .seal(&host.name)
                 .ok_or_else(|| RemoteError::NoKey(host.name.clone()))?;
-            seals.insert(keys::replies(run, &host.name), (host.name.clone(), seal));
+            host_seals.push(seal);
         }
+        let seals: HashMap<String, (String, Seal)> = options
+            .hosts
+            .iter()
+            .zip(&host_seals)
+            .map(|(host, seal)| {
+                (
+                    keys::replies(run, &host.name),
+                    (host.name.clone(), seal.clone()),
+                )
+            })
+            .collect();
         let session = options.zenoh.open_world(&options.listen)?;
         let (sender, incoming) = mpsc::channel();
         let replies_sender = sender.clone();
@@ -279,7 +290,7 @@ impl RemoteHosts {
             .wait()
             .map_err(zenoh_error("declaring the world's liveliness token"))?;
         let mut hosts = Vec::with_capacity(options.hosts.len());
-        for share in &options.hosts {
+        for (share, seal) in options.hosts.iter().zip(host_seals) {
             let frames_key = keys::frames(run, &share.name);
             let publisher = session
                 .declare_publisher(frames_key.clone())
@@ -298,7 +309,7 @@ impl RemoteHosts {
                 live_from: 1,
                 returning: false,
                 publisher,
-                seal: options.keys.seal(&share.name).unwrap_or(Seal::Off),
+                seal,
                 frames_key,
                 events: Vec::new(),
             });

@@ -269,7 +269,7 @@ pub fn run(
     progress.finish_and_clear();
     let interrupted = stop.load(Ordering::Relaxed);
 
-    let plots_missing = summarise(
+    let (plots_missing, _) = summarise(
         &grid,
         std::slice::from_ref(&batch),
         &root,
@@ -408,12 +408,7 @@ fn merge(
     }
     std::fs::write(root.join("grid.toml"), &grid.text).map_err(io("copying the grid"))?;
     let runs_planned = configurations.len() * grid.seeds.len();
-    let plots_missing = summarise(grid, &sources, &root, configurations, runs_planned)?;
-    let found = sources
-        .iter()
-        .flat_map(|source| finished_runs(grid, source, configurations))
-        .collect::<std::collections::BTreeSet<_>>()
-        .len();
+    let (plots_missing, found) = summarise(grid, &sources, &root, configurations, runs_planned)?;
     Ok(BatchReport {
         dir: root,
         configurations: configurations.len(),
@@ -445,14 +440,14 @@ fn finished_runs(
 }
 
 /// Reads every run finished in one of `sources` (the first that holds it) and writes `results.csv`, the figures
-/// and `report.md` into `root`; returns why figures are missing, if they are.
+/// and `report.md` into `root`; returns why figures are missing, if they are, and how many runs it read.
 fn summarise(
     grid: &Grid,
     sources: &[BatchDir],
     root: &Path,
     configurations: &[Configuration],
     runs_planned: usize,
-) -> Result<Option<String>, ExperimentError> {
+) -> Result<(Option<String>, usize), ExperimentError> {
     let mut runs: Vec<RunResult> = Vec::new();
     for source in sources {
         for (index, seed) in finished_runs(grid, source, configurations) {
@@ -514,7 +509,7 @@ fn summarise(
         &facts,
     );
     write(root, "report.md", &text)?;
-    Ok(plots_missing)
+    Ok((plots_missing, runs.len()))
 }
 
 fn write(root: &Path, name: &str, text: &str) -> Result<(), ExperimentError> {

@@ -441,8 +441,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     supervision.collect_agents();
     supervision.progress.finish_and_clear();
     let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
-    complete_summary(&out_dir, &report, &provenance, None)?;
-    if let Some(reason) = stopped_early(&out_dir) {
+    if let Some(reason) = complete_summary(&out_dir, &report, &provenance, None)? {
         return Err(LaunchError::StoppedEarly {
             ticks: report.ticks,
             reason,
@@ -450,13 +449,6 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         });
     }
     Ok(report)
-}
-
-/// Why the world stopped the run before its end (its disk budget), as its `summary.json` says.
-fn stopped_early(out_dir: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(out_dir.join(run_dir::SUMMARY_FILE)).ok()?;
-    let summary: serde_json::Value = serde_json::from_str(&text).ok()?;
-    summary["stopped_early"].as_str().map(str::to_owned)
 }
 
 /// Builds every controller of the run once, before any process of the run starts (`robot-agent --check` for the
@@ -878,13 +870,14 @@ impl Supervision {
 }
 
 /// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none, e.g. because
-/// it died: `world_died` then says why).
+/// it died: `world_died` then says why). Returns why the world stopped the run before its end (its disk
+/// budget, `stopped_early`), if it did.
 fn complete_summary(
     out_dir: &Path,
     report: &RunReport,
     provenance: &Provenance,
     world_died: Option<&str>,
-) -> Result<(), LaunchError> {
+) -> Result<Option<String>, LaunchError> {
     let path = out_dir.join(run_dir::SUMMARY_FILE);
     let mut summary = std::fs::read_to_string(&path)
         .ok()
@@ -924,7 +917,8 @@ fn complete_summary(
     }
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n";
     run_dir::write_atomically(&path, text.as_bytes())
-        .map_err(io(format!("writing {}", path.display())))
+        .map_err(io(format!("writing {}", path.display())))?;
+    Ok(summary["stopped_early"].as_str().map(str::to_owned))
 }
 
 /// Where a run came from: what was run, by which program, when, from which configuration.
