@@ -26,13 +26,13 @@ pub fn controller_of(experiment: &Experiment, robot: u32) -> Result<&Controller,
         ));
     };
     experiment
-        .controller(&entry.epuck.controller)
+        .controller(&entry.entity.controller)
         .ok_or_else(|| {
             experiment.diagnostic(
-                entry.epuck.location,
+                entry.entity.location,
                 format!(
                     "robot {robot} (`{}`) names controller `{}`, which is not declared",
-                    entry.id, entry.epuck.controller
+                    entry.id, entry.entity.controller
                 ),
             )
         })

@@ -1,30 +1,33 @@
-//! The e-puck actuators applied to the arena: wheels (differential drive), LEDs, range-and-bearing emitter,
-//! pheromone deposit and the virtual gripper. Applied once per tick, after control and before physics.
+//! The actuators applied to the arena: wheels (differential drive, with each body's wheel base and speed limit),
+//! LEDs, range-and-bearing emitter, pheromone deposit and the virtual gripper. Applied once per tick, after
+//! control and before physics.
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use swarm_contract::messages::{ActuatorCommand, GripperAction, PHEROMONE_CHANNELS};
 
 use crate::arena::{Arena, GripperEvent};
-use crate::entities::{ROBOT_RADIUS, RobotId, TargetId, TargetState};
+use crate::entities::{RobotId, TargetId, TargetState};
 use crate::geometry::unit;
 use crate::media::rab::RabMedium;
 
-/// Wheel speed limit in cm/s (the real e-puck's, docs/epuck-and-world.md 1.1).
-pub const MAX_WHEEL_SPEED_CM_S: f32 = 12.8;
-/// Distance between the wheels in metres.
-pub const INTER_WHEEL_DISTANCE: f32 = 0.053;
 /// Default largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm);
 /// the `virtual_gripper` actuator's `pickup_gap` overrides it.
 pub const GRIPPER_REACH: f32 = 0.007;
 /// Gap in metres between the robot's edge and a target it drops in front of itself.
 pub const DROP_GAP: f32 = 0.001;
 
-/// Clamps each wheel to +-12.8 cm/s, then applies the multiplicative Gaussian noise `v <- v + v N(0, sigma)`.
-pub fn wheel_speeds(commanded: [f32; 2], noise_std_dev: f32, rng: &mut ChaCha8Rng) -> [f32; 2] {
+/// Clamps each wheel to +-`max_cm_s` (the e-puck's 12.8 cm/s), then applies the multiplicative Gaussian noise
+/// `v <- v + v N(0, sigma)`.
+pub fn wheel_speeds(
+    commanded: [f32; 2],
+    max_cm_s: f32,
+    noise_std_dev: f32,
+    rng: &mut ChaCha8Rng,
+) -> [f32; 2] {
     let mut w = commanded.map(|v| {
         if v.is_finite() {
-            v.clamp(-MAX_WHEEL_SPEED_CM_S, MAX_WHEEL_SPEED_CM_S)
+            v.clamp(-max_cm_s, max_cm_s)
         } else {
             0.0
         }
@@ -39,10 +42,11 @@ pub fn wheel_speeds(commanded: [f32; 2], noise_std_dev: f32, rng: &mut ChaCha8Rn
     w
 }
 
-/// The unicycle velocities of wheel speeds in cm/s: `v = (vl + vr) / 2` in m/s and `w = (vr - vl) / 0.053` in rad/s.
-pub fn unicycle(wheels_cm_s: [f32; 2]) -> (f32, f32) {
+/// The unicycle velocities of wheel speeds in cm/s on wheels `inter_wheel_distance` metres apart:
+/// `v = (vl + vr) / 2` in m/s and `w = (vr - vl) / inter_wheel_distance` in rad/s.
+pub fn unicycle(wheels_cm_s: [f32; 2], inter_wheel_distance: f32) -> (f32, f32) {
     let (l, r) = (wheels_cm_s[0] / 100.0, wheels_cm_s[1] / 100.0);
-    ((l + r) / 2.0, (r - l) / INTER_WHEEL_DISTANCE)
+    ((l + r) / 2.0, (r - l) / inter_wheel_distance)
 }
 
 /// Applies `command` to robot `id`, or holds it still when `command` is `None` (no command, or dead).
@@ -63,10 +67,11 @@ pub fn apply(
     };
     robot.wheels = wheel_speeds(
         cmd.wheels,
+        robot.body.max_wheel_speed_cm_s,
         robot.devices.wheel_noise_std_dev,
         &mut robot.rng.wheels,
     );
-    let (v, w) = unicycle(robot.wheels);
+    let (v, w) = unicycle(robot.wheels, robot.body.inter_wheel_distance);
     arena.physics.drive(robot.handles.body, v, w);
     robot.led = cmd.led;
     if let Some(opts) = robot.devices.rab
@@ -100,7 +105,7 @@ pub fn target_in_reach(arena: &Arena, id: RobotId) -> Option<TargetId> {
         .iter()
         .enumerate()
         .filter(|(_, t)| t.state == TargetState::InArena)
-        .map(|(i, t)| (i, t.placed.gap_to_disc(robot.position, ROBOT_RADIUS)))
+        .map(|(i, t)| (i, t.placed.gap_to_disc(robot.position, robot.body.radius)))
         .filter(|&(_, gap)| gap <= robot.devices.gripper_reach)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| TargetId(i as u32))
@@ -126,7 +131,7 @@ fn drop_carried(arena: &mut Arena, id: RobotId) {
     let robot = &arena.robots[id.index()];
     let Some(target) = robot.carrying else { return };
     let radius = arena.targets[target.index()].radius();
-    let position = robot.position + unit(robot.heading) * (ROBOT_RADIUS + radius + DROP_GAP);
+    let position = robot.position + unit(robot.heading) * (robot.body.radius + radius + DROP_GAP);
     arena.place_target(target, position);
     arena.gripper_events.push(GripperEvent::Dropped {
         robot: id,

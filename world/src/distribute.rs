@@ -10,7 +10,6 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use swarm_contract::config::{Distribute, Entity, Euler, OrientationMethod, PositionMethod, Vec3};
 
-use crate::entities::ROBOT_RADIUS;
 use crate::error::WorldError;
 use crate::geometry::{Placed, Shape, Vec2};
 
@@ -23,8 +22,8 @@ pub fn outline(entity: &Entity, position: Vec2, yaw: f32) -> Option<Placed> {
         Entity::Cylinder(c) => Shape::Disc {
             radius: c.radius as f32,
         },
-        Entity::EPuck(_) => Shape::Disc {
-            radius: ROBOT_RADIUS,
+        Entity::Robot(r) => Shape::Disc {
+            radius: r.kind.body().radius,
         },
         Entity::Target(t) => Shape::Disc {
             radius: t.radius as f32,

@@ -4,6 +4,7 @@
 //! that leave the arena change state instead of disappearing, so handles stay valid for the whole run). Systems
 //! (sensors, actuators, media, loop functions) are functions over these sets; no entity points at another.
 
+use swarm_contract::bodies::{BodyModel, CameraView, EPUCK};
 use swarm_contract::messages::Rgb;
 
 use crate::devices::Devices;
@@ -11,12 +12,8 @@ use crate::geometry::{Placed, Shape, Vec2};
 use crate::physics::{BodyHandles, Motion};
 use crate::rng::RobotStreams;
 
-/// e-puck body radius in metres (docs/epuck-and-world.md 1.1).
-pub const ROBOT_RADIUS: f32 = 0.035;
-/// e-puck body height in metres (IRIDIA model); bodies this tall occlude what passes below their top.
-pub const ROBOT_HEIGHT: f32 = 0.076;
-/// Height of the robot's LED blob, below the camera (0.122 m) so other robots see it.
-pub const ROBOT_LED_HEIGHT: f32 = 0.086;
+/// e-puck body radius in metres (docs/epuck-and-world.md 1.1); other bodies are in `swarm_contract::bodies`.
+pub const ROBOT_RADIUS: f32 = EPUCK.radius;
 
 macro_rules! handle {
     ($(#[$doc:meta])* $name:ident) => {
@@ -50,11 +47,15 @@ handle!(
     LightId
 );
 
-/// One e-puck.
+/// One robot.
 #[derive(Debug)]
 pub struct Robot {
     /// The id from the configuration (`fb0`, `ep12`, ...).
     pub name: String,
+    /// Its body: shape, wheels and sensor placement.
+    pub body: &'static BodyModel,
+    /// What its camera sees (the body's, unless the configuration sets another aperture).
+    pub camera_view: CameraView,
     /// The controller id the configuration assigns.
     pub controller: String,
     /// Physics handles.

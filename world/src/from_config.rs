@@ -3,12 +3,13 @@
 //!
 //! Mapping of entities: `<box>` and `<cylinder>` are obstacles (walls are simply boxes), unless they carry
 //! `<leds>`, in which case they are targets (ARGoS' passive objects with an LED; one LED each); `<target>` is a
-//! target; `<e-puck>` a robot; `<light>` a light. Every failure is a [`WorldError`] naming `file:line:column`.
+//! target; `<e-puck>` and `<foot-bot>` robots; `<light>` a light. Every failure is a [`WorldError`] naming `file:line:column`.
 
 use swarm_contract::config::{
     self, Controller, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
-use swarm_contract::messages::{PHEROMONE_CHANNELS, RAB_PAYLOAD_BYTES, Rgb};
+use swarm_contract::bodies::RobotKind;
+use swarm_contract::messages::{PHEROMONE_CHANNELS, Rgb};
 
 use crate::actuators::GRIPPER_REACH;
 use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions};
@@ -43,8 +44,9 @@ pub fn grey_level(c: Rgb) -> f32 {
     (0.299 * f32::from(c.r) + 0.587 * f32::from(c.g) + 0.114 * f32::from(c.b)) / 255.0
 }
 
-/// The devices a controller declares.
-pub fn devices(exp: &Experiment, c: &Controller) -> Result<Devices, WorldError> {
+/// The devices a controller declares, for a robot of `kind` (whose body bounds the range-and-bearing payload).
+pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devices, WorldError> {
+    let max_payload = kind.body().rab_data_size;
     let proximity = match c.sensor(DeviceKind::Proximity) {
         None => None,
         Some(d) => {
@@ -72,11 +74,14 @@ pub fn devices(exp: &Experiment, c: &Controller) -> Result<Devices, WorldError> 
                     .map_err(|e| invalid(exp, e.location, e.message))
             };
             let data_size = attr("data_size")?.unwrap_or(2.0);
-            if !(1.0..=RAB_PAYLOAD_BYTES as f64).contains(&data_size) || data_size.fract() != 0.0 {
+            if !(1.0..=f64::from(max_payload)).contains(&data_size) || data_size.fract() != 0.0 {
                 return Err(invalid(
                     exp,
                     d.location,
-                    format!("data_size {data_size} must be 1 to {RAB_PAYLOAD_BYTES} bytes"),
+                    format!(
+                        "data_size {data_size} must be 1 to {max_payload} bytes on the {}",
+                        kind.tag()
+                    ),
                 ));
             }
             let loss = attr("loss_probability")?.unwrap_or(0.0);
@@ -298,31 +303,37 @@ fn add_entity(
         return Ok(());
     };
     match entity {
-        Entity::EPuck(e) => {
+        Entity::Robot(e) => {
             let controller = exp.controller(&e.controller).ok_or_else(|| {
                 invalid(
                     exp,
                     e.location,
                     format!(
-                        "e-puck '{}' uses undeclared controller '{}'",
-                        e.id, e.controller
+                        "{} '{}' uses undeclared controller '{}'",
+                        e.kind.tag(),
+                        e.id,
+                        e.controller
                     ),
                 )
             })?;
-            let mut devices = devices(exp, controller)?;
+            let mut devices = devices(exp, controller, e.kind)?;
             if let (Some(rab), Some(size)) = (devices.rab.as_mut(), e.rab_data_size) {
-                if !(1..=RAB_PAYLOAD_BYTES as u32).contains(&size) {
+                let max = u32::from(e.kind.body().rab_data_size);
+                if !(1..=max).contains(&size) {
                     return Err(invalid(
                         exp,
                         e.location,
-                        format!("rab_data_size {size} must be 1 to {RAB_PAYLOAD_BYTES} bytes"),
+                        format!("rab_data_size {size} must be 1 to {max} bytes"),
                     ));
                 }
                 rab.data_size = size as u8;
             }
-            let id = b.robot(&e.id, &e.controller, position, yaw, devices);
+            let id = b.robot_of_kind(e.kind, &e.id, &e.controller, position, yaw, devices);
             if let Some(range) = e.rab_range {
                 b.rab_range(id, range as f32);
+            }
+            if let Some(aperture) = e.camera_aperture_deg {
+                b.camera_aperture(id, (aperture as f32).to_radians());
             }
         }
         Entity::Box(x) => add_passive(

@@ -6,7 +6,7 @@
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
-use crate::actuators::MAX_WHEEL_SPEED_CM_S;
+use swarm_contract::bodies::EPUCK;
 
 /// Front-sensor reading above which the robot turns (docs/tasks.md 3, theta_obs).
 pub const OBSTACLE_THRESHOLD: f32 = 0.1;
@@ -16,7 +16,7 @@ pub fn avoid_obstacles(frame: &SensorFrame, command: &mut ActuatorCommand) {
     let p = &frame.proximity;
     let left = p[0].max(p[1]);
     let right = p[7].max(p[6]);
-    let v = MAX_WHEEL_SPEED_CM_S;
+    let v = EPUCK.max_wheel_speed_cm_s;
     command.wheels = if left.max(right) <= OBSTACLE_THRESHOLD {
         [v, v]
     } else if left >= right {

@@ -15,8 +15,6 @@ use rapier2d::prelude::{
 
 use crate::geometry::{Shape, Vec2};
 
-/// Mass of an e-puck in kg.
-pub const ROBOT_MASS: f32 = 0.2;
 /// Ground friction of movable objects, as linear and angular damping per second: a pushed object stops soon.
 pub const MOVABLE_DAMPING: f32 = 5.0;
 
@@ -136,15 +134,22 @@ impl Physics {
         BodyHandles { body, collider }
     }
 
-    /// Adds an e-puck: a dynamic disc of `radius` whose velocity the world sets every tick.
-    pub fn add_robot(&mut self, radius: f32, position: Vec2, angle: f32, tag: u128) -> BodyHandles {
+    /// Adds a robot: a dynamic disc of `radius` and `mass` (kg) whose velocity the world sets every tick.
+    pub fn add_robot(
+        &mut self,
+        radius: f32,
+        mass: f32,
+        position: Vec2,
+        angle: f32,
+        tag: u128,
+    ) -> BodyHandles {
         let body = RigidBodyBuilder::dynamic()
             .translation(position)
             .rotation(angle)
             .can_sleep(false)
             .build();
         let collider = ColliderBuilder::ball(radius)
-            .mass(ROBOT_MASS)
+            .mass(mass)
             .friction(0.0)
             .restitution(0.0)
             .user_data(tag)

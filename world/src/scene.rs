@@ -3,11 +3,12 @@
 //! Rebuilt once per tick after physics (robots first, so a robot's scene index is its robot index). Sensors
 //! gather the few bodies near a robot with one grid query and test their rays against those shapes only.
 
-use crate::entities::{Obstacle, ROBOT_HEIGHT, ROBOT_RADIUS, Robot, Target, TargetState};
+use crate::entities::{Obstacle, Robot, Target, TargetState};
 use crate::geometry::{Aabb, Placed, Shape, Vec2};
 use crate::spatial::Grid;
 
-/// Side of a scene grid cell in metres: a proximity query (robot plus 5 cm) touches at most four cells.
+/// Side of a scene grid cell in metres: an e-puck's proximity query (robot plus 5 cm) touches at most four cells,
+/// a foot-bot's (robot plus 10 cm) at most nine.
 pub const SCENE_CELL: f32 = 0.25;
 
 /// What a scene body is.
@@ -55,12 +56,12 @@ impl Scene {
             self.refs.push(BodyRef::Robot(i as u32));
             self.shapes.push(Placed::new(
                 Shape::Disc {
-                    radius: ROBOT_RADIUS,
+                    radius: r.body.radius,
                 },
                 r.position,
                 r.heading,
             ));
-            self.heights.push(ROBOT_HEIGHT);
+            self.heights.push(r.body.height);
         }
         for (i, o) in obstacles.iter().enumerate() {
             self.refs.push(BodyRef::Obstacle(i as u32));
@@ -129,6 +130,3 @@ impl Scene {
         hit
     }
 }
-
-/// The radius of the disc around a robot centre that the proximity rays can reach.
-pub const PROXIMITY_REACH: f32 = ROBOT_RADIUS + crate::sensors::proximity::PROXIMITY_RANGE;

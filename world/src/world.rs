@@ -6,6 +6,7 @@
 //! [`World::act_and_step`] only reuses buffers around the rapier2d step (which allocates a few small buffers of its
 //! own per step).
 
+use swarm_contract::bodies::{CameraView, RobotKind};
 use swarm_contract::config::Experiment;
 use swarm_contract::config::faults::DeadBodies;
 use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
@@ -14,8 +15,8 @@ use crate::actuators;
 use crate::arena::Arena;
 use crate::devices::Devices;
 use crate::entities::{
-    FloorRegion, Light, LightId, Obstacle, ObstacleId, ROBOT_RADIUS, Robot, RobotId, Target,
-    TargetId, TargetState, floor_grey,
+    FloorRegion, Light, LightId, Obstacle, ObstacleId, Robot, RobotId, Target, TargetId,
+    TargetState, floor_grey,
 };
 use crate::error::WorldError;
 use crate::geometry::{Placed, Vec2};
@@ -28,8 +29,8 @@ use crate::rng::RobotStreams;
 use crate::scene::Scene;
 use crate::sensors::{Observer, camera, ground, light, proximity, rab};
 
-/// Default range of a robot's range-and-bearing emitter in metres.
-pub const DEFAULT_RAB_RANGE: f32 = 0.8;
+/// Default range of an e-puck's range-and-bearing emitter in metres (each body has its own).
+pub const DEFAULT_RAB_RANGE: f32 = swarm_contract::bodies::EPUCK.rab_range;
 /// Default pheromone cell side in metres (docs/tasks.md 5.2).
 pub const DEFAULT_PHEROMONE_CELL: f32 = 0.05;
 
@@ -79,15 +80,32 @@ impl WorldBuilder {
         heading: f32,
         devices: Devices,
     ) -> RobotId {
+        self.robot_of_kind(RobotKind::EPuck, name, controller, position, heading, devices)
+    }
+
+    /// Adds a robot of `kind` at `position` facing `heading` radians.
+    pub fn robot_of_kind(
+        &mut self,
+        kind: RobotKind,
+        name: &str,
+        controller: &str,
+        position: Vec2,
+        heading: f32,
+        devices: Devices,
+    ) -> RobotId {
         let id = RobotId(self.arena.robots.len() as u32);
+        let body = kind.body();
         let handles = self.arena.physics.add_robot(
-            ROBOT_RADIUS,
+            body.radius,
+            body.mass,
             position,
             heading,
             TAG_ROBOT | u128::from(id.0),
         );
         self.arena.robots.push(Robot {
             name: name.to_owned(),
+            body,
+            camera_view: body.camera_view,
             controller: controller.to_owned(),
             handles,
             position,
@@ -98,11 +116,19 @@ impl WorldBuilder {
             wheels: [0.0; 2],
             carrying: None,
             collisions: 0,
-            rab_range: DEFAULT_RAB_RANGE,
+            rab_range: body.rab_range,
             devices,
             rng: RobotStreams::new(self.seed, id.0),
         });
         id
+    }
+
+    /// Sets the half-aperture in radians of a robot's omnidirectional camera (the foot-bot's
+    /// `omnidirectional_camera_aperture`).
+    pub fn camera_aperture(&mut self, robot: RobotId, aperture: f32) {
+        if let Some(r) = self.arena.robots.get_mut(robot.index()) {
+            r.camera_view = CameraView::Aperture(aperture);
+        }
     }
 
     /// Sets a robot's range-and-bearing emitter range in metres.
@@ -197,7 +223,7 @@ impl WorldBuilder {
         let (min, max) = (self.arena.min, self.arena.max);
         let mut world = World {
             scene: Scene::new(min, max),
-            leds: LedMedium::new(min, max, camera::CAMERA_RANGE),
+            leds: LedMedium::new(min, max, camera::LED_CELL),
             rab: RabMedium::new(min, max, DEFAULT_RAB_RANGE),
             arena: self.arena,
             loop_functions: self.loop_functions,
@@ -343,41 +369,47 @@ impl World {
             frame.alive = 1;
             frame.camera_len = 0;
             frame.rab_len = 0;
-            let (pos, heading) = (robot.position, robot.heading);
+            let (pos, heading, body) = (robot.position, robot.heading, robot.body);
             let observer = Observer {
                 me,
                 position: pos,
                 heading,
+                body,
             };
             let devices = robot.devices;
             if let Some(opts) = &devices.proximity {
+                let n = body.proximity_angles_deg.len();
+                frame.proximity_len = n as u8;
                 proximity::sense(
                     &self.scene,
                     observer,
                     opts,
                     &mut robot.rng.proximity,
                     &mut self.scratch,
-                    &mut frame.proximity,
+                    &mut frame.proximity[..n],
                 );
             }
             if let Some(level) = devices.light {
+                let n = body.light_angles_deg.len();
+                frame.light_len = n as u8;
                 light::sense(
                     &self.scene,
                     &arena.lights,
                     observer,
                     level,
                     &mut robot.rng.light,
-                    &mut frame.light,
+                    &mut frame.light[..n],
                 );
             }
             if let Some(level) = devices.ground {
+                let n = body.ground_offsets.len();
+                frame.ground_len = n as u8;
                 ground::sense(
-                    pos,
-                    heading,
+                    observer,
                     floor,
                     level,
                     &mut robot.rng.ground,
-                    &mut frame.ground,
+                    &mut frame.ground[..n],
                 );
             }
             if let Some(opts) = &devices.camera {
@@ -385,6 +417,7 @@ impl World {
                     &self.scene,
                     &self.leds,
                     observer,
+                    robot.camera_view,
                     opts,
                     &mut robot.rng.camera,
                     frame,

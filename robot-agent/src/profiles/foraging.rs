@@ -582,9 +582,9 @@ mod tests {
     fn is_in_home_when_the_middle_ground_sensor_reads_black() {
         let f = forager(&[]);
         let mut fr = frame(1);
-        fr.ground = [0.0, 1.0, 0.0];
+        fr.ground[..3].copy_from_slice(&[0.0, 1.0, 0.0]);
         assert!(!is_in_home(&f, &fr));
-        fr.ground = [1.0, 0.2, 1.0];
+        fr.ground[..3].copy_from_slice(&[1.0, 0.2, 1.0]);
         assert!(is_in_home(&f, &fr));
     }
 

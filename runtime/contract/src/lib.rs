@@ -4,7 +4,8 @@
 //! link this crate, so it holds only what they must agree on:
 //!
 //! - what a controller may see and do: the sensor frame and actuator command ([`messages`], the world-to-agent
-//!   and agent-to-world protocol), and the ptSCT [`player`] that runs a robot's supervisors;
+//!   and agent-to-world protocol), the robot bodies and where their sensors sit ([`bodies`]), and the ptSCT
+//!   [`player`] that runs a robot's supervisors;
 //! - the experiment configuration ([`config`]): the `.argos` model and its parser, with the fault schedule and
 //!   the host list as sections of the same document, and the fault schedule expanded for one run ([`fault_plan`]);
 //! - the local lockstep [`transport`] over iceoryx2 shared memory;
@@ -19,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod alloc_count;
+pub mod bodies;
 pub mod config;
 pub mod cpu;
 pub mod disk_budget;

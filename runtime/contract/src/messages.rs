@@ -6,7 +6,8 @@
 //! if a callback needs something new, it is added here, not passed through a side channel.
 //!
 //! Capacities are compile-time constants because shared-memory layouts must be identical in every process; they
-//! are sized for the e-puck model and the thesis' tasks. Any change to a layout must bump [`MESSAGE_VERSION`],
+//! are sized for the largest body (`crate::bodies`: the foot-bot's 24-sensor rings) and the thesis' tasks, and a
+//! length field says how many entries a robot's body fills. Any change to a layout must bump [`MESSAGE_VERSION`],
 //! which is part of every service name, so processes built from different versions never connect.
 //!
 //! Across hosts the same types travel bincode-encoded (`Encode`/`Decode`, field by field, little-endian), never
@@ -16,20 +17,20 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 1;
+pub const MESSAGE_VERSION: u32 = 2;
 
-/// Number of e-puck proximity sensors (also the light sensors: they share the IR ring).
-pub const PROXIMITY_SENSORS: usize = 8;
-/// Number of e-puck light sensors.
-pub const LIGHT_SENSORS: usize = 8;
-/// Number of e-puck ground sensors (left, centre, right).
-pub const GROUND_SENSORS: usize = 3;
+/// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
+pub const MAX_PROXIMITY_SENSORS: usize = 24;
+/// Most light sensors a body has (the foot-bot's 24; the e-puck has 8).
+pub const MAX_LIGHT_SENSORS: usize = 24;
+/// Most ground sensors a body has (the foot-bot's four motor-ground sensors; the e-puck has 3).
+pub const MAX_GROUND_SENSORS: usize = 4;
 /// Most LED blobs the omnidirectional camera reports per tick; further blobs (farthest first) are dropped.
 pub const MAX_CAMERA_BLOBS: usize = 16;
 /// Most range-and-bearing messages a robot receives per tick; further messages (farthest first) are dropped.
 pub const MAX_RAB_MESSAGES: usize = 16;
-/// Largest range-and-bearing payload, in bytes (the IRIDIA e-puck's maximum).
-pub const RAB_PAYLOAD_BYTES: usize = 4;
+/// Largest range-and-bearing payload, in bytes (the foot-bot's default 10; the IRIDIA e-puck's maximum is 4).
+pub const RAB_PAYLOAD_BYTES: usize = 10;
 /// Number of pheromone channels in the world's field (e.g. trail and home).
 pub const PHEROMONE_CHANNELS: usize = 2;
 /// Most supervisors one robot may run.
@@ -101,12 +102,20 @@ pub struct SensorFrame {
     pub alive: u8,
     /// Non-zero while the robot carries an object with its virtual gripper.
     pub gripper_holding: u8,
-    /// Proximity readings in [0, 1] (0 nothing, 1 touching), sensor i at the e-puck's physical angle.
-    pub proximity: [f32; PROXIMITY_SENSORS],
-    /// Light readings in [0, 1].
-    pub light: [f32; LIGHT_SENSORS],
-    /// Ground readings in [0, 1] (1 white, 0 black); index 0 is the left sensor.
-    pub ground: [f32; GROUND_SENSORS],
+    /// Number of valid entries in `proximity` (the body's sensor count; 0 when the sensor is not declared).
+    pub proximity_len: u8,
+    /// Proximity readings in [0, 1] (0 nothing, 1 touching), sensor i at the body's i-th proximity angle
+    /// (`crate::bodies::BodyModel::proximity_angles_deg`).
+    pub proximity: [f32; MAX_PROXIMITY_SENSORS],
+    /// Number of valid entries in `light`.
+    pub light_len: u8,
+    /// Light readings in [0, 1], sensor i at the body's i-th light angle.
+    pub light: [f32; MAX_LIGHT_SENSORS],
+    /// Number of valid entries in `ground`.
+    pub ground_len: u8,
+    /// Ground readings in [0, 1] (1 white, 0 black), in the body's ground-sensor order (e-puck: index 0 is the
+    /// left sensor).
+    pub ground: [f32; MAX_GROUND_SENSORS],
     /// Number of valid entries in `camera`.
     pub camera_len: u8,
     /// LED blobs seen by the omnidirectional camera, nearest first.
@@ -133,9 +142,12 @@ impl SensorFrame {
             robot,
             alive: 1,
             gripper_holding: 0,
-            proximity: [0.0; PROXIMITY_SENSORS],
-            light: [0.0; LIGHT_SENSORS],
-            ground: [1.0; GROUND_SENSORS],
+            proximity_len: 0,
+            proximity: [0.0; MAX_PROXIMITY_SENSORS],
+            light_len: 0,
+            light: [0.0; MAX_LIGHT_SENSORS],
+            ground_len: 0,
+            ground: [1.0; MAX_GROUND_SENSORS],
             camera_len: 0,
             camera: [CameraBlob::default(); MAX_CAMERA_BLOBS],
             rab_len: 0,
@@ -165,6 +177,21 @@ impl SensorFrame {
             frame.tick = tick;
             frame.robot = robot;
         }
+    }
+
+    /// The valid proximity readings.
+    pub fn proximity_readings(&self) -> &[f32] {
+        &self.proximity[..usize::from(self.proximity_len).min(MAX_PROXIMITY_SENSORS)]
+    }
+
+    /// The valid light readings.
+    pub fn light_readings(&self) -> &[f32] {
+        &self.light[..usize::from(self.light_len).min(MAX_LIGHT_SENSORS)]
+    }
+
+    /// The valid ground readings.
+    pub fn ground_readings(&self) -> &[f32] {
+        &self.ground[..usize::from(self.ground_len).min(MAX_GROUND_SENSORS)]
     }
 
     /// The valid camera blobs.

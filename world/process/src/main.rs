@@ -96,7 +96,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .arena
         .robots()
         .into_iter()
-        .map(|r| (r.id, r.epuck.controller.clone()))
+        .map(|r| (r.id, r.entity.controller.clone()))
         .collect();
 
     let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;

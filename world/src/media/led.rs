@@ -3,7 +3,7 @@
 
 use swarm_contract::messages::Rgb;
 
-use crate::entities::{Light, ROBOT_LED_HEIGHT, Robot, Target, TargetState};
+use crate::entities::{Light, Robot, Target, TargetState};
 use crate::geometry::{Aabb, Vec2};
 use crate::scene::BodyRef;
 use crate::spatial::Grid;
@@ -50,7 +50,7 @@ impl LedMedium {
         {
             self.leds.push(LedSource {
                 position: r.position,
-                height: ROBOT_LED_HEIGHT,
+                height: r.body.led_height,
                 color: r.led,
                 owner: Some(BodyRef::Robot(i as u32)),
             });

@@ -8,7 +8,7 @@ use swarm_contract::messages::{PHEROMONE_CHANNELS, Rgb};
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use crate::arena::Arena;
-use crate::entities::{ROBOT_RADIUS, TargetState};
+use crate::entities::TargetState;
 use crate::error::WorldError;
 use crate::geometry::{Placed, Shape, Vec2, unit};
 use crate::world::World;
@@ -81,7 +81,7 @@ pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
     for r in arena.robots.iter().filter(|r| !r.removed) {
         let body = Placed::new(
             Shape::Disc {
-                radius: ROBOT_RADIUS,
+                radius: r.body.radius,
             },
             r.position,
             r.heading,
@@ -93,8 +93,8 @@ pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
         };
         fill_placed(&mut pixmap, &body, &fill, tf);
         let mut pb = PathBuilder::new();
-        pb.push_circle(r.position.x, r.position.y, ROBOT_RADIUS);
-        let tip = r.position + unit(r.heading) * ROBOT_RADIUS;
+        pb.push_circle(r.position.x, r.position.y, r.body.radius);
+        let tip = r.position + unit(r.heading) * r.body.radius;
         pb.move_to(r.position.x, r.position.y);
         pb.line_to(tip.x, tip.y);
         if let Some(path) = pb.finish() {

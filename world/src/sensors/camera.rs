@@ -1,9 +1,11 @@
-//! The omnidirectional camera: the lit LEDs within 0.35 m, lower than the camera, not the robot's own and not
-//! hidden behind a body; reported nearest first as colour, bearing and distance in cm, at most
-//! `swarm_contract::messages::MAX_CAMERA_BLOBS` of them.
+//! The omnidirectional camera: the lit LEDs in view, lower than the camera, not the robot's own and not hidden
+//! behind a body; reported nearest first as colour, bearing and distance in cm, at most
+//! `swarm_contract::messages::MAX_CAMERA_BLOBS` of them. What is in view depends on the body: the e-puck sees
+//! LEDs within 0.35 m, the foot-bot those inside its camera's cone (`swarm_contract::bodies::CameraView`).
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use swarm_contract::bodies::CameraView;
 use swarm_contract::messages::{CameraBlob, SensorFrame};
 
 use crate::devices::CameraOptions;
@@ -13,16 +15,15 @@ use crate::scene::{BodyRef, Scene};
 use crate::sensors::Observer;
 use crate::sensors::insert_nearest;
 
-/// Radius of the ground disc the camera sees, in metres.
-pub const CAMERA_RANGE: f32 = 0.35;
-/// Height of the camera above the ground in metres; only LEDs below it are seen.
-pub const CAMERA_HEIGHT: f32 = 0.122;
+/// Side of the LED medium's grid cells in metres: the e-puck camera's range, so its query touches at most four.
+pub const LED_CELL: f32 = 0.35;
 
-/// Fills the camera part of `frame` for robot `me` at `position`/`heading`.
+/// Fills the camera part of `frame` for robot `me`, whose camera sees `view`.
 pub fn sense(
     scene: &Scene,
     leds: &LedMedium,
     observer: Observer,
+    view: CameraView,
     options: &CameraOptions,
     rng: &mut ChaCha8Rng,
     frame: &mut SensorFrame,
@@ -31,21 +32,27 @@ pub fn sense(
         me,
         position,
         heading,
+        body,
     } = observer;
+    let body = swarm_contract::bodies::BodyModel {
+        camera_view: view,
+        ..*body
+    };
+    let camera_height = body.camera_height;
     let mut len = 0usize;
     let noise = (options.noise_std_dev > 0.0)
         .then(|| Normal::new(0.0f32, options.noise_std_dev).ok())
         .flatten();
-    leds.near(position, CAMERA_RANGE, |led| {
-        if led.owner == Some(BodyRef::Robot(me)) || led.height >= CAMERA_HEIGHT {
+    leds.near(position, body.camera_reach(), |led| {
+        if led.owner == Some(BodyRef::Robot(me)) || led.height >= camera_height {
             return;
         }
         let mut rel = led.position - position;
         let d = rel.length();
-        if d > CAMERA_RANGE
+        if d > body.camera_range(led.height)
             || scene.blocked(
                 position,
-                CAMERA_HEIGHT,
+                camera_height,
                 led.position,
                 led.height,
                 [Some(BodyRef::Robot(me)), led.owner],

@@ -1,5 +1,6 @@
-//! The e-puck sensors, each a function from the world's state after the last physics step to one part of a
-//! robot's `SensorFrame`. Sensors only read the world; they never move or change anything.
+//! The sensors, each a function from the world's state after the last physics step to one part of a robot's
+//! `SensorFrame`, placed as the robot's body says. Sensors only read the world; they never move or change
+//! anything.
 
 pub mod camera;
 pub mod ground;
@@ -8,17 +9,29 @@ pub mod noise;
 pub mod proximity;
 pub mod rab;
 
+use swarm_contract::bodies::BodyModel;
+
 use crate::geometry::Vec2;
 
-/// The robot a sensor reads for: its index (robots are the first bodies of the scene) and its pose.
+/// The robot a sensor reads for: its index (robots are the first bodies of the scene), its pose and its body.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observer {
+    /// Its body: where its sensors sit.
+    pub body: &'static BodyModel,
     /// Robot index, equal to its scene index.
     pub me: u32,
     /// Position of the point between the wheels.
     pub position: Vec2,
     /// Heading in radians.
     pub heading: f32,
+}
+
+impl Observer {
+    /// A point given in the robot frame (x forward, y left), in the arena frame.
+    pub fn to_arena(&self, local: Vec2) -> Vec2 {
+        let (s, c) = self.heading.sin_cos();
+        self.position + Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y)
+    }
 }
 
 /// Inserts `item` into the first `len` entries of `items`, kept sorted by ascending `key` (nearest first); when

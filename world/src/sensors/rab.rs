@@ -1,22 +1,19 @@
 //! The range-and-bearing receiver: messages broadcast in the previous tick by other robots whose emitter range
-//! reaches this robot and whose line of sight is not cut by a body taller than a robot. Range is reported in cm
-//! minus two body radii and bearing in the receiver's frame (the IRIDIA convention); each message may be lost
-//! with the receiver's `loss_probability`. Nearest first, at most `swarm_contract::messages::MAX_RAB_MESSAGES`.
+//! reaches this robot and whose line of sight is not cut by a body taller than the receiver's turret. Range is
+//! reported in cm (an e-puck: minus two e-puck radii, the IRIDIA convention; a foot-bot: centre to centre, as
+//! ARGoS does) and bearing in the receiver's frame; each message may be lost with the receiver's
+//! `loss_probability`. Nearest first, at most `swarm_contract::messages::MAX_RAB_MESSAGES`.
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use swarm_contract::messages::{RabMessage, SensorFrame};
 
 use crate::devices::RabOptions;
-use crate::entities::{ROBOT_HEIGHT, ROBOT_RADIUS};
 use crate::geometry::wrap_angle;
 use crate::media::rab::RabMedium;
 use crate::scene::{BodyRef, Scene};
 use crate::sensors::Observer;
 use crate::sensors::insert_nearest;
-
-/// Height of the range-and-bearing turret above the ground, in metres.
-pub const RAB_HEIGHT: f32 = ROBOT_HEIGHT;
 
 /// Fills the range-and-bearing part of `frame` for robot `me` at `position`/`heading`.
 pub fn sense(
@@ -31,7 +28,14 @@ pub fn sense(
         me,
         position,
         heading,
+        body,
     } = observer;
+    let turret = body.rab_height;
+    let surfaces_cm = if body.rab_range_between_surfaces {
+        2.0 * body.radius * 100.0
+    } else {
+        0.0
+    };
     let mut len = 0usize;
     medium.near(position, |msg| {
         if msg.sender == me {
@@ -44,11 +48,11 @@ pub fn sense(
         }
         let blocked = scene.blocked(
             position,
-            RAB_HEIGHT,
+            turret,
             msg.position,
-            RAB_HEIGHT,
+            turret,
             [Some(BodyRef::Robot(me)), Some(BodyRef::Robot(msg.sender))],
-            RAB_HEIGHT + f32::EPSILON,
+            turret + f32::EPSILON,
         );
         if blocked
             || (options.loss_probability > 0.0 && rng.random::<f32>() < options.loss_probability)
@@ -59,7 +63,7 @@ pub fn sense(
             sender: msg.sender,
             payload: msg.payload,
             len: msg.len.min(options.data_size),
-            range_cm: d * 100.0 - 2.0 * ROBOT_RADIUS * 100.0,
+            range_cm: d * 100.0 - surfaces_cm,
             bearing: wrap_angle(rel.y.atan2(rel.x) - heading),
         };
         insert_nearest(&mut frame.rab, &mut len, received, |m| m.range_cm);

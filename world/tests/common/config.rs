@@ -18,6 +18,7 @@ fn device(name: &str, kind: DeviceKind, role: DeviceRole, line: u32) -> Device {
         noise_level: 0.0,
         noise_std_dev: 0.0,
         medium: None,
+        body: None,
         attributes: Element {
             name: name.into(),
             location: at(line),
@@ -78,11 +79,13 @@ pub fn uniform(
 
 /// The e-puck template `<e-puck id="fb"><controller config="fdc"/></e-puck>`.
 pub fn epuck(id: &str, line: u32) -> Entity {
-    Entity::EPuck(EPuckEntity {
+    Entity::Robot(RobotEntity {
+        kind: swarm_contract::bodies::RobotKind::EPuck,
         id: id.into(),
         controller: "fdc".into(),
         rab_range: None,
         rab_data_size: None,
+        camera_aperture_deg: None,
         location: at(line),
     })
 }

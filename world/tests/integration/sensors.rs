@@ -1,12 +1,13 @@
 //! Sensor models against analytic geometry, with the numbers of docs/epuck-and-world.md section 1.
 
 use crate::common::{builder, frames, wall};
+use swarm_contract::bodies::EPUCK;
 use swarm_contract::messages::Rgb;
 use swarm_world::devices::{Devices, ProximityOptions};
 use swarm_world::entities::{FloorRegion, Light, ROBOT_RADIUS};
 use swarm_world::geometry::{Placed, Shape, Vec2};
 use swarm_world::physics::Motion;
-use swarm_world::sensors::light::{SENSOR_HEIGHT, intensity_at};
+use swarm_world::sensors::light::intensity_at;
 use swarm_world::sensors::proximity::iridia_curve;
 
 const RED: Rgb = Rgb { r: 255, g: 0, b: 0 };
@@ -101,7 +102,7 @@ fn proximity_reads_zero_beyond_five_centimetres_from_the_edge() {
         Vec2::new(0.1, 1.0),
     );
     let mut world = b.build();
-    assert_eq!(frames(&mut world)[0].proximity, [0.0; 8]);
+    assert_eq!(frames(&mut world)[0].proximity_readings(), [0.0; 8]);
 }
 
 #[test]
@@ -178,7 +179,7 @@ fn light_world(light_height: f32, blocker: bool) -> swarm_world::World {
 fn light_reading_is_the_iridia_exponential_weighted_by_sensor_angle() {
     let mut world = light_world(0.5, false);
     let l = frames(&mut world)[0].light;
-    let d = (1.0f32 + (0.5 - SENSOR_HEIGHT).powi(2)).sqrt();
+    let d = (1.0f32 + (0.5 - EPUCK.light_height).powi(2)).sqrt();
     let base = (-2.0 * d / 3.0).exp();
     assert!((intensity_at(d, 3.0) - base).abs() < 1e-7);
     let want0 = base * (1.0 - 2.0 * 17f32.to_radians() / std::f32::consts::PI);
@@ -193,7 +194,7 @@ fn light_reading_is_the_iridia_exponential_weighted_by_sensor_angle() {
 #[test]
 fn light_behind_a_taller_box_is_occluded() {
     let mut world = light_world(0.2, true);
-    assert_eq!(frames(&mut world)[0].light, [0.0; 8]);
+    assert_eq!(frames(&mut world)[0].light_readings(), [0.0; 8]);
 }
 
 #[test]
@@ -215,7 +216,7 @@ fn light_farther_than_2_5_intensities_reads_zero() {
         color: RED,
     });
     let mut world = b.build();
-    assert_eq!(frames(&mut world)[0].light, [0.0; 8]);
+    assert_eq!(frames(&mut world)[0].light_readings(), [0.0; 8]);
 }
 
 #[test]
@@ -229,7 +230,7 @@ fn ground_sensors_read_the_region_under_each_sensor_left_first() {
         grey: 0.0,
     });
     let mut world = b.build();
-    assert_eq!(frames(&mut world)[0].ground, [0.0, 1.0, 1.0]);
+    assert_eq!(frames(&mut world)[0].ground_readings(), [0.0, 1.0, 1.0]);
 }
 
 #[test]
@@ -243,7 +244,7 @@ fn ground_sensors_turn_with_the_robot() {
         grey: 0.5,
     });
     let mut world = b.build();
-    assert_eq!(frames(&mut world)[0].ground, [0.5, 0.5, 0.5]);
+    assert_eq!(frames(&mut world)[0].ground_readings(), [0.5, 0.5, 0.5]);
 }
 
 fn food(b: &mut swarm_world::WorldBuilder, at: Vec2) {
@@ -305,7 +306,7 @@ fn rab_reports_range_minus_two_radii_and_bearing_in_the_receiver_frame() {
     let mut world = b.build();
     let mut cmds = vec![swarm_contract::messages::ActuatorCommand::idle(0, 1); 3];
     cmds[0].rab_len = 2;
-    cmds[0].rab_payload = [7, 9, 0, 0];
+    cmds[0].rab_payload[..2].copy_from_slice(&[7, 9]);
     world.act_and_step(&cmds, &[true, true, true]);
     let f = frames(&mut world);
     let got = f[1].rab_messages();

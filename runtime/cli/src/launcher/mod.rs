@@ -393,9 +393,9 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .iter()
             .map(|r| {
                 RobotEntry::new(
-                    r.epuck.controller.clone(),
+                    r.entity.controller.clone(),
                     RestartTracker::new(
-                        schedule.restart_rule(r.index, &r.epuck.controller).cloned(),
+                        schedule.restart_rule(r.index, &r.entity.controller).cloned(),
                     ),
                 )
             })
@@ -471,7 +471,7 @@ fn check_controllers(
     let mut compiled = HashMap::new();
     let mut tables = serde_json::Map::new();
     for robot in roster {
-        let controller = &robot.epuck.controller;
+        let controller = &robot.entity.controller;
         if tables.contains_key(controller) {
             continue;
         }
@@ -538,7 +538,7 @@ fn write_configuration_as_run(
             .arena
             .distributions
             .iter()
-            .find(|d| matches!(d.template, swarm_contract::config::Entity::EPuck(_)))
+            .find(|d| matches!(d.template, swarm_contract::config::Entity::Robot(_)))
             .map(|d| d.quantity)
     });
     let overrides = as_run::Overrides {

@@ -13,6 +13,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+use crate::bodies::RobotKind;
 use crate::messages::Rgb;
 
 use super::diagnostic::Diagnostic;
@@ -322,11 +323,13 @@ pub enum DeviceKind {
     Wheels,
     /// LEDs: `epuck_rgb_leds`, `epuck_base_leds`, `leds` (actuator).
     Leds,
-    /// The 8 IR proximity sensors: `epuck_proximity`, `proximity`.
+    /// The IR proximity ring (8 on the e-puck, 24 on the foot-bot): `epuck_proximity`, `footbot_proximity`,
+    /// `proximity`.
     Proximity,
-    /// The 8 light sensors: `epuck_light`, `light`.
+    /// The light sensors (8 on the e-puck, 24 on the foot-bot): `epuck_light`, `footbot_light`, `light`.
     Light,
-    /// The 3 ground sensors: `epuck_ground`, `ground`.
+    /// The ground sensors (3 on the e-puck, the foot-bot's 4 motor-ground sensors): `epuck_ground`,
+    /// `footbot_motor_ground`, `ground`.
     Ground,
     /// The omnidirectional LED-blob camera: `epuck_omnidirectional_camera`, `colored_blob_omnidirectional_camera`.
     OmnidirectionalCamera,
@@ -359,6 +362,8 @@ pub struct Device {
     pub noise_std_dev: f64,
     /// `medium`: the id of the medium the device uses, if any (checked against `<media>`).
     pub medium: Option<String>,
+    /// The only robot the device exists on (`epuck_*`, `footbot_*` names), or `None` for a generic device.
+    pub body: Option<RobotKind>,
     /// All attributes as written, including the typed ones above (e.g. `data_size`, `show_rays`, `range`).
     pub attributes: Element,
     /// Where the device element is.
@@ -430,8 +435,8 @@ pub struct Robot<'a> {
     pub index: u32,
     /// The robot's id (a distribution's robots are `base id` + index, e.g. `fb0`).
     pub id: String,
-    /// The `<e-puck>` element (for distributed robots: the template).
-    pub epuck: &'a EPuckEntity,
+    /// The robot's element, `<e-puck>` or `<foot-bot>` (for distributed robots: the template).
+    pub entity: &'a RobotEntity,
 }
 
 impl Arena {
@@ -442,14 +447,14 @@ impl Arena {
         for item in self.items() {
             match item {
                 ArenaItem::Placed(PlacedEntity {
-                    entity: Entity::EPuck(epuck),
+                    entity: Entity::Robot(robot),
                     ..
                 }) => {
-                    robots.push((epuck.id.clone(), epuck));
+                    robots.push((robot.id.clone(), robot));
                 }
                 ArenaItem::Distribute(d) => {
-                    if let Entity::EPuck(epuck) = &d.template {
-                        robots.extend((0..d.quantity).map(|i| (d.entity_id(i), epuck)));
+                    if let Entity::Robot(robot) = &d.template {
+                        robots.extend((0..d.quantity).map(|i| (d.entity_id(i), robot)));
                     }
                 }
                 ArenaItem::Placed(_) => {}
@@ -458,7 +463,7 @@ impl Arena {
         robots
             .into_iter()
             .zip(0u32..)
-            .map(|((id, epuck), index)| Robot { index, id, epuck })
+            .map(|((id, entity), index)| Robot { index, id, entity })
             .collect()
     }
 }
@@ -479,8 +484,8 @@ pub enum Entity {
     Box(BoxEntity),
     /// `<cylinder>`.
     Cylinder(CylinderEntity),
-    /// `<e-puck>`.
-    EPuck(EPuckEntity),
+    /// A robot: `<e-puck>` or `<foot-bot>`.
+    Robot(RobotEntity),
     /// `<light>`.
     Light(LightEntity),
     /// `<target>` (our extension): a foraging target the virtual gripper can pick up.
@@ -493,7 +498,7 @@ impl Entity {
         match self {
             Entity::Box(e) => &e.id,
             Entity::Cylinder(e) => &e.id,
-            Entity::EPuck(e) => &e.id,
+            Entity::Robot(e) => &e.id,
             Entity::Light(e) => &e.id,
             Entity::Target(e) => &e.id,
         }
@@ -504,7 +509,7 @@ impl Entity {
         match self {
             Entity::Box(e) => e.location,
             Entity::Cylinder(e) => e.location,
-            Entity::EPuck(e) => e.location,
+            Entity::Robot(e) => e.location,
             Entity::Light(e) => e.location,
             Entity::Target(e) => e.location,
         }
@@ -515,7 +520,7 @@ impl Entity {
         match self {
             Entity::Box(_) => "box",
             Entity::Cylinder(_) => "cylinder",
-            Entity::EPuck(_) => "e-puck",
+            Entity::Robot(e) => e.kind.tag(),
             Entity::Light(_) => "light",
             Entity::Target(_) => "target",
         }
@@ -532,7 +537,7 @@ impl Entity {
         match &mut copy {
             Entity::Box(e) => e.id = id,
             Entity::Cylinder(e) => e.id = id,
-            Entity::EPuck(e) => e.id = id,
+            Entity::Robot(e) => e.id = id,
             Entity::Light(e) => e.id = id,
             Entity::Target(e) => e.id = id,
         }
@@ -600,17 +605,22 @@ pub struct Led {
     pub location: Location,
 }
 
-/// `<e-puck id [rab_range] [rab_data_size]>` with `<controller config>`.
+/// `<e-puck id [rab_range] [rab_data_size]>` or `<foot-bot id [rab_range] [rab_data_size]
+/// [omnidirectional_camera_aperture]>`, with `<controller config>`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct EPuckEntity {
+pub struct RobotEntity {
+    /// Which robot the element places.
+    pub kind: RobotKind,
     /// Unique id.
     pub id: String,
     /// The `config` of `<controller>`: the id of a declared controller (checked).
     pub controller: String,
-    /// `rab_range` in metres (core e-puck), if given.
+    /// `rab_range` in metres, if given.
     pub rab_range: Option<f64>,
     /// `rab_data_size` in bytes, if given.
     pub rab_data_size: Option<u32>,
+    /// `omnidirectional_camera_aperture` in degrees (foot-bot), if given.
+    pub camera_aperture_deg: Option<f64>,
     /// Where the element is.
     pub location: Location,
 }

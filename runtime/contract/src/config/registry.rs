@@ -1,10 +1,12 @@
 //! The device registry: the sensor and actuator names configurations use, mapped to [`DeviceKind`].
 //!
 //! Names are registry keys (as in ARGoS): the `.argos` element name finds the entry here. Both e-puck plug-ins'
-//! names are accepted (docs/epuck-and-world.md section 4.2) plus ours: `virtual_gripper`, `pheromone` and
-//! `pheromone_deposit`.
+//! names are accepted (docs/epuck-and-world.md section 4.2), the foot-bot's (`footbot_proximity`, `footbot_light`,
+//! `footbot_motor_ground`), plus ours: `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
+//! name (`epuck_*`, `footbot_*`) is refused on a robot of another kind.
 
 use super::model::{DeviceKind, DeviceRole};
+use crate::bodies::RobotKind;
 
 /// Which kind of medium a device must name in its `medium` attribute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,6 +43,8 @@ pub(crate) struct Entry {
     pub medium: Option<MediumKind>,
     /// Attributes beyond `implementation`, `noise_level`, `noise_std_dev` and `medium` that this device reads.
     pub attributes: &'static [&'static str],
+    /// The only robot this device exists on (`epuck_*`, `footbot_*`), or `None` for a generic device.
+    pub body: Option<RobotKind>,
 }
 
 use DeviceKind as K;
@@ -62,6 +66,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Wheels,
         medium: None,
         attributes: &[],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "differential_steering",
@@ -69,6 +74,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Wheels,
         medium: None,
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "epuck_base_leds",
@@ -76,6 +82,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Leds,
         medium: None,
         attributes: &[],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "epuck_rgb_leds",
@@ -83,6 +90,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Leds,
         medium: Some(MediumKind::Led),
         attributes: &[],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "leds",
@@ -90,6 +98,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Leds,
         medium: Some(MediumKind::Led),
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "epuck_proximity",
@@ -97,6 +106,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Proximity,
         medium: None,
         attributes: &["argos_uniform_ring"],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "proximity",
@@ -104,6 +114,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Proximity,
         medium: None,
         attributes: &["argos_uniform_ring"],
+        body: None,
     },
     Entry {
         name: "epuck_light",
@@ -111,6 +122,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Light,
         medium: None,
         attributes: &[],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "light",
@@ -118,6 +130,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Light,
         medium: None,
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "epuck_ground",
@@ -125,6 +138,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Ground,
         medium: None,
         attributes: &[],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "ground",
@@ -132,6 +146,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Ground,
         medium: None,
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "epuck_omnidirectional_camera",
@@ -139,6 +154,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::OmnidirectionalCamera,
         medium: Some(MediumKind::Led),
         attributes: &["range"],
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "colored_blob_omnidirectional_camera",
@@ -146,6 +162,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::OmnidirectionalCamera,
         medium: Some(MediumKind::Led),
         attributes: &["range"],
+        body: None,
     },
     Entry {
         name: "epuck_range_and_bearing",
@@ -153,6 +170,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::RangeAndBearing,
         medium: Some(MediumKind::RangeAndBearing),
         attributes: RAB_ATTRIBUTES,
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "range_and_bearing",
@@ -160,6 +178,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::RangeAndBearing,
         medium: Some(MediumKind::RangeAndBearing),
         attributes: RAB_ATTRIBUTES,
+        body: None,
     },
     Entry {
         name: "epuck_range_and_bearing",
@@ -167,6 +186,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::RangeAndBearing,
         medium: Some(MediumKind::RangeAndBearing),
         attributes: RAB_ATTRIBUTES,
+        body: Some(RobotKind::EPuck),
     },
     Entry {
         name: "range_and_bearing",
@@ -174,6 +194,31 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::RangeAndBearing,
         medium: Some(MediumKind::RangeAndBearing),
         attributes: RAB_ATTRIBUTES,
+        body: None,
+    },
+    Entry {
+        name: "footbot_proximity",
+        role: S,
+        kind: K::Proximity,
+        medium: None,
+        attributes: &[],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_light",
+        role: S,
+        kind: K::Light,
+        medium: None,
+        attributes: &[],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_motor_ground",
+        role: S,
+        kind: K::Ground,
+        medium: None,
+        attributes: &[],
+        body: Some(RobotKind::FootBot),
     },
     Entry {
         name: "positioning",
@@ -181,6 +226,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Positioning,
         medium: None,
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "virtual_gripper",
@@ -188,6 +234,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::VirtualGripper,
         medium: None,
         attributes: &[],
+        body: None,
     },
     Entry {
         name: "virtual_gripper",
@@ -195,6 +242,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::VirtualGripper,
         medium: None,
         attributes: &["pickup_gap"],
+        body: None,
     },
     Entry {
         name: "pheromone",
@@ -202,6 +250,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Pheromone,
         medium: Some(MediumKind::Pheromone),
         attributes: &["channels"],
+        body: None,
     },
     Entry {
         name: "pheromone_deposit",
@@ -209,6 +258,7 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::PheromoneDeposit,
         medium: Some(MediumKind::Pheromone),
         attributes: &["channels"],
+        body: None,
     },
 ];
 

@@ -1,35 +1,36 @@
 //! Changing the number of robots of an experiment (`swarm run --robots N`).
 //!
-//! Robot numbering itself is [`Arena::robots`](super::model::Arena::robots); this only resizes the one e-puck
-//! `<distribute>` so that the arena holds `N` e-pucks in all, which the launcher and the world do identically.
+//! Robot numbering itself is [`Arena::robots`](super::model::Arena::robots); this only resizes the one robot
+//! `<distribute>` (of e-pucks or foot-bots) so that the arena holds `N` robots in all, which the launcher and the
+//! world do identically.
 
 use super::diagnostic::ConfigErrors;
 use super::model::{Entity, Experiment};
 
 impl Experiment {
-    /// The same experiment with `robots` e-pucks in all: the one e-puck `<distribute>` gets the quantity that
-    /// hand-placed e-pucks leave. Fails (located) when there is no such distribution, more than one, or more
-    /// hand-placed e-pucks than `robots`.
+    /// The same experiment with `robots` robots in all: the one robot `<distribute>` gets the quantity that
+    /// hand-placed robots leave. Fails (located) when there is no such distribution, more than one, or more
+    /// hand-placed robots than `robots`.
     pub fn with_robot_count(mut self, robots: u32) -> Result<Experiment, ConfigErrors> {
         let error = |experiment: &Experiment, location, message: String| ConfigErrors {
             errors: vec![experiment.diagnostic(location, message)],
         };
-        let epuck_distributions: Vec<usize> = self
+        let robot_distributions: Vec<usize> = self
             .arena
             .distributions
             .iter()
             .enumerate()
-            .filter(|(_, d)| matches!(d.template, Entity::EPuck(_)))
+            .filter(|(_, d)| matches!(d.template, Entity::Robot(_)))
             .map(|(i, _)| i)
             .collect();
-        let index = match epuck_distributions.as_slice() {
+        let index = match robot_distributions.as_slice() {
             [one] => *one,
             [] => {
                 return Err(error(
                     &self,
                     self.arena.location,
                     format!(
-                        "cannot run {robots} robots: the arena has no e-puck <distribute> whose quantity could change"
+                        "cannot run {robots} robots: the arena has no robot <distribute> whose quantity could change"
                     ),
                 ));
             }
@@ -39,9 +40,9 @@ impl Experiment {
                     &self,
                     location,
                     format!(
-                        "cannot run {robots} robots: the arena has {} e-puck <distribute> blocks and the robot count \
+                        "cannot run {robots} robots: the arena has {} robot <distribute> blocks and the robot count \
                          applies to exactly one",
-                        epuck_distributions.len()
+                        robot_distributions.len()
                     ),
                 ));
             }
@@ -50,13 +51,13 @@ impl Experiment {
             .arena
             .entities
             .iter()
-            .filter(|e| matches!(e.entity, Entity::EPuck(_)))
+            .filter(|e| matches!(e.entity, Entity::Robot(_)))
             .count() as u32;
         if robots < placed {
             return Err(error(
                 &self,
                 self.arena.location,
-                format!("cannot run {robots} robots: {placed} e-pucks are placed by hand"),
+                format!("cannot run {robots} robots: {placed} robots are placed by hand"),
             ));
         }
         self.arena.distributions[index].quantity = robots - placed;
@@ -118,7 +119,7 @@ mod tests {
         };
         assert_eq!(
             errors.to_string(),
-            "roster.argos:8:3: cannot run 0 robots: 1 e-pucks are placed by hand"
+            "roster.argos:8:3: cannot run 0 robots: 1 robots are placed by hand"
         );
     }
 }

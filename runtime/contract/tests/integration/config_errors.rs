@@ -502,11 +502,44 @@ fn sizes_must_be_positive() {
 
 #[test]
 fn other_robot_models_are_not_supported() {
-    let text = config(&[("ARENA", r#"<foot-bot id="fb"/>"#)]);
+    let text = config(&[("ARENA", r#"<eye-bot id="eb"/>"#)]);
     assert_error(
         &text,
-        "<foot-bot",
-        "entity <foot-bot> is not supported: the world simulates e-pucks",
+        "<eye-bot",
+        "entity <eye-bot> is not supported: the world simulates e-pucks and foot-bots",
+    );
+}
+
+#[test]
+fn a_device_of_another_robot_is_refused_where_it_is_declared() {
+    let text = config(&[(
+        "ARENA",
+        r#"<e-puck id="ep"><body position="0,0,0"/><controller config="fdc"/></e-puck>"#,
+    )])
+    .replace(SENSORS, r#"<footbot_proximity implementation="default"/>"#);
+    let robot_at = at(&text, "<e-puck");
+    assert_error(
+        &text,
+        "<footbot_proximity",
+        &format!(
+            "'footbot_proximity' exists only on the foot-bot, but <e-puck> 'ep' at {robot_at} uses controller \
+             'fdc' (use the generic name (e.g. proximity, light, ground) or a controller for this robot)"
+        ),
+    );
+}
+
+#[test]
+fn a_footbot_payload_beyond_ten_bytes_is_refused() {
+    let text = config(&[(
+        "ARENA",
+        r#"<foot-bot id="fb" rab_data_size="11"><body position="0,0,0"/><controller config="fdc"/></foot-bot>"#,
+    )])
+    .replace("<epuck_wheels implementation=\"default\"/>", "<differential_steering implementation=\"default\"/>")
+    .replace(SENSORS, r#"<footbot_proximity implementation="default"/>"#);
+    assert_error(
+        &text,
+        "rab_data_size=",
+        "'rab_data_size' in <foot-bot> must be between 1 and 10, got 11",
     );
 }
 

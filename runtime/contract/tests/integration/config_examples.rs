@@ -99,7 +99,7 @@ fn thesis_example_loads_with_section_5_values() {
     assert_eq!(d[0].entity_id(0), "fb0");
     assert_eq!(d[0].entity_id(39), "fb39");
     match &d[0].template {
-        Entity::EPuck(e) => assert_eq!(e.controller, "fdc"),
+        Entity::Robot(e) => assert_eq!(e.controller, "fdc"),
         other => panic!("first distribution places e-pucks, got {other:?}"),
     }
     match &d[2].template {
@@ -147,7 +147,7 @@ fn robots_are_numbered_in_file_order_with_generated_ids() {
     assert_eq!(robots.len(), 40);
     assert_eq!((robots[0].index, robots[0].id.as_str()), (0, "fb0"));
     assert_eq!((robots[39].index, robots[39].id.as_str()), (39, "fb39"));
-    assert!(robots.iter().all(|r| r.epuck.controller == "fdc"));
+    assert!(robots.iter().all(|r| r.entity.controller == "fdc"));
 
     let (grid, _) = load("runtime/contract/tests/fixtures/good/grid_and_rab.argos");
     let ids: Vec<String> = grid.arena.robots().into_iter().map(|r| r.id).collect();
@@ -384,7 +384,7 @@ fn grid_fixture_reads_core_names_rab_and_grid() {
     );
     assert_eq!(grid.entity_id(0), "r100");
     match &grid.template {
-        Entity::EPuck(e) => assert_eq!((e.rab_range, e.rab_data_size), (Some(1.5), Some(4))),
+        Entity::Robot(e) => assert_eq!((e.rab_range, e.rab_data_size), (Some(1.5), Some(4))),
         other => panic!("e-puck expected, got {other:?}"),
     }
     assert!(matches!(

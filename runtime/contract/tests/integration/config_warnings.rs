@@ -151,3 +151,13 @@ fn target_led_above_the_camera_is_flagged() {
         "configs/test.argos:13:48: target LED at 0.2 m is not below the e-puck camera (0.122 m): cameras will not see it"
     );
 }
+
+#[test]
+fn footbot_perspective_camera_attributes_are_ignored_with_a_warning() {
+    let arena = r#"<foot-bot id="fb" perspective_camera_front="false"><body position="0,0,0"/><controller config="fdc"/></foot-bot>"#;
+    let text = config(EXPERIMENT, "<proximity/>", arena, "");
+    assert_eq!(
+        warnings(&text)[0],
+        "configs/test.argos:13:23: 'perspective_camera_front' is ignored: the world simulates no perspective camera"
+    );
+}

@@ -1,20 +1,22 @@
-//! `<arena>`: entities (box, cylinder, e-puck, light, our target), the floor, and `<distribute>` blocks.
+//! `<arena>`: entities (box, cylinder, e-puck, foot-bot, light, our target), the floor, and `<distribute>` blocks.
 
 use super::{Ctx, MediumRef};
 use crate::config::model::{
-    Arena, BoxEntity, CylinderEntity, Distribute, EPuckEntity, Element, Entity, Euler, Floor,
+    Arena, BoxEntity, CylinderEntity, Distribute, RobotEntity, Element, Entity, Euler, Floor,
     FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose,
     PositionMethod, TargetEntity, Vec3,
 };
 use crate::config::registry::MediumKind;
+use crate::bodies::RobotKind;
 use crate::config::suggest::did_you_mean;
 use crate::messages::Rgb;
 
-const ENTITIES: &[&str] = &["box", "cylinder", "e-puck", "light", "target"];
+const ENTITIES: &[&str] = &["box", "cylinder", "e-puck", "foot-bot", "light", "target"];
 const ARENA_CHILDREN: &[&str] = &[
     "box",
     "cylinder",
     "e-puck",
+    "foot-bot",
     "light",
     "target",
     "floor",
@@ -22,7 +24,6 @@ const ARENA_CHILDREN: &[&str] = &[
 ];
 /// ARGoS entities we recognise but do not simulate.
 const UNSUPPORTED_ENTITIES: &[&str] = &[
-    "foot-bot",
     "eye-bot",
     "spiri",
     "kheperaiv",
@@ -33,7 +34,9 @@ const UNSUPPORTED_ENTITIES: &[&str] = &[
     "block",
 ];
 /// Height of the e-puck omnidirectional camera (docs/epuck-and-world.md 1.5): LEDs at or above it are never seen.
+/// `bodies::EPUCK.camera_height` as written in messages (the `f32` would print as 0.12200000137...).
 const CAMERA_HEIGHT: f64 = 0.122;
+const _: () = assert!(CAMERA_HEIGHT as f32 == crate::bodies::EPUCK.camera_height);
 /// Default LED height of a `<target>` (docs/tasks.md 4.9: a red LED at 0.06 m).
 const TARGET_LED_HEIGHT: f64 = 0.06;
 /// Default floor resolution when `pixels_per_meter` is absent.
@@ -88,7 +91,7 @@ pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
             name if UNSUPPORTED_ENTITIES.contains(&name) => {
                 ctx.error(
                     child.location,
-                    format!("entity <{name}> is not supported: the world simulates e-pucks"),
+                    format!("entity <{name}> is not supported: the world simulates e-pucks and foot-bots"),
                     None,
                 );
             }
@@ -125,7 +128,7 @@ fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<En
         name => {
             let children: &[&str] = match name {
                 "box" | "cylinder" => &["body", "leds"],
-                "e-puck" => &["body", "controller"],
+                "e-puck" | "foot-bot" => &["body", "controller"],
                 _ => &["body"],
             };
             let mut body: Option<&Element> = None;
@@ -156,7 +159,9 @@ fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<En
             match name {
                 "box" => box_entity(ctx, el).map(Entity::Box),
                 "cylinder" => cylinder(ctx, el).map(Entity::Cylinder),
-                "e-puck" => epuck(ctx, el).map(Entity::EPuck),
+                robot if RobotKind::from_tag(robot).is_some() => {
+                    robot_entity(ctx, el).map(Entity::Robot)
+                }
                 _ => target(ctx, el).map(Entity::Target),
             }
         }
@@ -312,14 +317,45 @@ fn medium_ref(ctx: &mut Ctx, el: &Element, kind: MediumKind, user: String) -> Op
     Some(id)
 }
 
-fn epuck(ctx: &mut Ctx, el: &Element) -> Option<EPuckEntity> {
-    ctx.unknown_attributes(el, &["id", "rab_range", "rab_data_size"]);
+/// Foot-bot attributes ARGoS reads for devices the world does not simulate: accepted with a warning.
+const IGNORED_FOOTBOT_ATTRIBUTES: &[&str] = &[
+    "perspective_camera_front",
+    "perspective_camera_aperture",
+    "perspective_camera_focal_length",
+    "perspective_camera_range",
+];
+
+/// `<e-puck>` or `<foot-bot>`: id, range-and-bearing options, the foot-bot's camera aperture, `<controller>`.
+fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
+    let kind = RobotKind::from_tag(&el.name)?;
+    let body = kind.body();
+    let mut known = vec!["id", "rab_range", "rab_data_size"];
+    if kind == RobotKind::FootBot {
+        known.push("omnidirectional_camera_aperture");
+        known.extend_from_slice(IGNORED_FOOTBOT_ATTRIBUTES);
+        for name in IGNORED_FOOTBOT_ATTRIBUTES {
+            if let Some(a) = el.attributes.get(*name) {
+                ctx.warn(
+                    a.location,
+                    format!("'{name}' is ignored: the world simulates no perspective camera"),
+                    None,
+                );
+            }
+        }
+    }
+    ctx.unknown_attributes(el, &known);
     let id: Option<String> = ctx.required(el, "id");
     let rab_range: Option<f64> = ctx.attr(el, "rab_range");
     let rab_range_ok = rab_range.is_none_or(|r| ctx.in_range(el, "rab_range", r, 0.0, None));
     let rab_data_size: Option<u32> = ctx.attr(el, "rab_data_size");
-    let rab_data_size_ok = rab_data_size
-        .is_none_or(|d| ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(4.0)));
+    let rab_data_size_ok = rab_data_size.is_none_or(|d| {
+        let max = f64::from(body.rab_data_size);
+        ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(max))
+    });
+    let camera_aperture_deg: Option<f64> = ctx.attr(el, "omnidirectional_camera_aperture");
+    let aperture_ok = camera_aperture_deg.is_none_or(|a| {
+        ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0))
+    });
     let mut controllers = el.children.iter().filter(|c| c.name == "controller");
     let controller = match (controllers.next(), controllers.next()) {
         (Some(c), None) => {
@@ -333,18 +369,20 @@ fn epuck(ctx: &mut Ctx, el: &Element) -> Option<EPuckEntity> {
         (None, _) => {
             ctx.error(
                 el.location,
-                "<e-puck> needs a <controller config=\"controller id\"/>",
+                format!("<{}> needs a <controller config=\"controller id\"/>", el.name),
                 None,
             );
             None
         }
     };
-    (rab_range_ok && rab_data_size_ok).then_some(())?;
-    Some(EPuckEntity {
+    (rab_range_ok && rab_data_size_ok && aperture_ok).then_some(())?;
+    Some(RobotEntity {
+        kind,
         id: id?,
         controller: controller?,
         rab_range,
         rab_data_size,
+        camera_aperture_deg,
         location: el.location,
     })
 }

@@ -1,7 +1,7 @@
 //! Checks across sections, run once everything is read: media references, controller references, entity ids
 //! (including the ids `<distribute>` generates: base id + index, no separator) and positions inside the arena.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::Ctx;
 use super::arena::describe;
@@ -135,6 +135,8 @@ fn media_references(ctx: &mut Ctx, experiment: &Experiment) {
     }
 }
 
+/// Every robot's controller is declared, and declares no device that exists only on another robot (e.g.
+/// `footbot_proximity` for an e-puck). Reported once per controller and robot kind.
 fn controller_references(ctx: &mut Ctx, experiment: &Experiment) {
     let robots = experiment
         .arena
@@ -142,11 +144,12 @@ fn controller_references(ctx: &mut Ctx, experiment: &Experiment) {
         .iter()
         .map(|p| &p.entity)
         .chain(experiment.arena.distributions.iter().map(|d| &d.template));
+    let mut checked = HashSet::new();
     for entity in robots {
-        let Entity::EPuck(robot) = entity else {
+        let Entity::Robot(robot) = entity else {
             continue;
         };
-        if experiment.controller(&robot.controller).is_none() {
+        let Some(controller) = experiment.controller(&robot.controller) else {
             let hint = did_you_mean(
                 &robot.controller,
                 experiment.controllers.iter().map(|c| c.id.as_str()),
@@ -154,10 +157,36 @@ fn controller_references(ctx: &mut Ctx, experiment: &Experiment) {
             ctx.error(
                 robot.location,
                 format!(
-                    "<e-puck> '{}' refers to controller '{}', which <controllers> does not declare",
-                    robot.id, robot.controller
+                    "<{}> '{}' refers to controller '{}', which <controllers> does not declare",
+                    robot.kind.tag(),
+                    robot.id,
+                    robot.controller
                 ),
                 hint,
+            );
+            continue;
+        };
+        if !checked.insert((controller.id.as_str(), robot.kind)) {
+            continue;
+        }
+        let foreign = controller
+            .sensors
+            .iter()
+            .chain(&controller.actuators)
+            .filter_map(|d| d.body.filter(|&body| body != robot.kind).map(|body| (d, body)));
+        for (device, body) in foreign {
+            ctx.error(
+                device.location,
+                format!(
+                    "'{}' exists only on the {}, but <{}> '{}' at {} uses controller '{}'",
+                    device.name,
+                    body.tag(),
+                    robot.kind.tag(),
+                    robot.id,
+                    robot.location,
+                    controller.id
+                ),
+                Some("use the generic name (e.g. proximity, light, ground) or a controller for this robot".into()),
             );
         }
     }

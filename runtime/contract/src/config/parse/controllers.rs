@@ -247,6 +247,7 @@ fn device(ctx: &mut Ctx, el: &Element, entry: &Entry, controller: &str) -> Optio
         noise_level,
         noise_std_dev,
         medium: entry.medium.and(medium),
+        body: entry.body,
         attributes: Element {
             children: Vec::new(),
             ..el.clone()
