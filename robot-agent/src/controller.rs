@@ -96,6 +96,12 @@ const BUILTINS: &[Builtin] = &[
             name: native::epuck_obstacleavoidance::EpuckObstacleAvoidance::NAME.to_owned(),
         },
     },
+    Builtin {
+        element: "footbot_diffusion_controller",
+        plan: || Plan::Native {
+            name: native::footbot_diffusion::FootbotDiffusion::NAME.to_owned(),
+        },
+    },
 ];
 
 /// Why a controller element does not name something this agent can run.
@@ -346,12 +352,12 @@ mod tests {
 
     #[test]
     fn unknown_element_lists_the_known_names() {
-        let err = plan("footbot_diffusion", &Params::default(), Path::new("/c")).unwrap_err();
+        let err = plan("footbot_flocking", &Params::default(), Path::new("/c")).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "unknown controller `footbot_diffusion`: give `profile` and `supervisors` in <params>, or use one of: \
+            "unknown controller `footbot_flocking`: give `profile` and `supervisors` in <params>, or use one of: \
              epuck_obstacle_avoidance_sct_prob_controller, epuck_obstacleavoidance_controller, \
-             epuck_obstacleavoidance"
+             footbot_diffusion_controller, epuck_obstacleavoidance, footbot_diffusion"
         );
     }
 }

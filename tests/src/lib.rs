@@ -79,14 +79,19 @@ impl SwarmOutcome {
     }
 }
 
-/// Runs `swarm <args>` to completion with the test-built programs.
+/// Runs `swarm <args>` to completion from the workspace root with the test-built programs.
 pub fn swarm(args: &[&str]) -> SwarmOutcome {
+    swarm_in(&workspace_root(), args)
+}
+
+/// Runs `swarm <args>` to completion from the folder `cwd` with the test-built programs.
+pub fn swarm_in(cwd: &Path, args: &[&str]) -> SwarmOutcome {
     let dir = bin_dir();
     let child = Command::new(dir.join("swarm"))
         .args(args)
         .env("SWARM_BIN_DIR", dir)
         .env("RUST_LOG", "info")
-        .current_dir(workspace_root())
+        .current_dir(cwd)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -166,15 +171,20 @@ fn assert_prefix_clean(prefix: &str) {
     );
 }
 
-/// Starts `swarm <args>` with the test-built programs and returns it running, standard error piped (for tests
-/// that talk to a live run).
+/// Starts `swarm <args>` from the workspace root with the test-built programs and returns it running, standard
+/// error piped (for tests that talk to a live run).
 pub fn spawn_swarm(args: &[&str]) -> std::process::Child {
+    spawn_swarm_in(&workspace_root(), args)
+}
+
+/// Starts `swarm <args>` from the folder `cwd`, as [`spawn_swarm`] does.
+pub fn spawn_swarm_in(cwd: &Path, args: &[&str]) -> std::process::Child {
     let dir = bin_dir();
     Command::new(dir.join("swarm"))
         .args(args)
         .env("SWARM_BIN_DIR", dir)
         .env("RUST_LOG", "info")
-        .current_dir(workspace_root())
+        .current_dir(cwd)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()

@@ -5,10 +5,10 @@
 //! `<leds>`, in which case they are targets (ARGoS' passive objects with an LED; one LED each); `<target>` is a
 //! target; `<e-puck>` and `<foot-bot>` robots; `<light>` a light. Every failure is a [`WorldError`] naming `file:line:column`.
 
+use swarm_contract::bodies::RobotKind;
 use swarm_contract::config::{
     self, Controller, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
-use swarm_contract::bodies::RobotKind;
 use swarm_contract::messages::{PHEROMONE_CHANNELS, Rgb};
 
 use crate::actuators::GRIPPER_REACH;

@@ -80,7 +80,14 @@ impl WorldBuilder {
         heading: f32,
         devices: Devices,
     ) -> RobotId {
-        self.robot_of_kind(RobotKind::EPuck, name, controller, position, heading, devices)
+        self.robot_of_kind(
+            RobotKind::EPuck,
+            name,
+            controller,
+            position,
+            heading,
+            devices,
+        )
     }
 
     /// Adds a robot of `kind` at `position` facing `heading` radians.

@@ -2,12 +2,14 @@
 //! use for them.
 
 pub mod epuck_obstacleavoidance;
+pub mod footbot_diffusion;
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
 
 use crate::params::{ParamError, Params};
 use epuck_obstacleavoidance::EpuckObstacleAvoidance;
+use footbot_diffusion::FootbotDiffusion;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
 pub trait NativeController: Send {
@@ -21,9 +23,14 @@ pub type BoxedNative = Box<dyn NativeController>;
 type BuildFn = fn(&Params) -> Result<BoxedNative, ParamError>;
 
 /// Every native controller, by name.
-const NATIVE: &[(&str, BuildFn)] = &[(EpuckObstacleAvoidance::NAME, |p| {
-    Ok(Box::new(EpuckObstacleAvoidance::from_params(p)?))
-})];
+const NATIVE: &[(&str, BuildFn)] = &[
+    (EpuckObstacleAvoidance::NAME, |p| {
+        Ok(Box::new(EpuckObstacleAvoidance::from_params(p)?))
+    }),
+    (FootbotDiffusion::NAME, |p| {
+        Ok(Box::new(FootbotDiffusion::from_params(p)?))
+    }),
+];
 
 /// Why a native controller could not be built.
 #[derive(Debug, Clone, PartialEq, Error)]

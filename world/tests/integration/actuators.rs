@@ -200,7 +200,11 @@ fn inert_dead_body_is_seen_and_pushed_aside() {
 fn removed_dead_body_is_neither_seen_nor_hit_and_comes_back_with_its_robot() {
     let mut world = dead_robot_ahead(DeadBodies::Removed);
     assert!(world.arena.robots[1].removed);
-    assert_eq!(frames(&mut world)[0].proximity_readings(), [0.0; 8], "nothing seen");
+    assert_eq!(
+        frames(&mut world)[0].proximity_readings(),
+        [0.0; 8],
+        "nothing seen"
+    );
     drive(&mut world, 40, wheels(10.0, 10.0));
     assert!(
         world.arena.robots[0].position.x > 0.09 + 2.0 * ROBOT_RADIUS,

@@ -6,6 +6,7 @@ mod common;
 
 mod actuators;
 mod config;
+mod footbot;
 mod run;
 mod sensors;
 mod shipped_configs;

@@ -395,7 +395,9 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
                 RobotEntry::new(
                     r.entity.controller.clone(),
                     RestartTracker::new(
-                        schedule.restart_rule(r.index, &r.entity.controller).cloned(),
+                        schedule
+                            .restart_rule(r.index, &r.entity.controller)
+                            .cloned(),
                     ),
                 )
             })

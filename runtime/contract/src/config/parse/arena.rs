@@ -1,13 +1,13 @@
 //! `<arena>`: entities (box, cylinder, e-puck, foot-bot, light, our target), the floor, and `<distribute>` blocks.
 
 use super::{Ctx, MediumRef};
+use crate::bodies::RobotKind;
 use crate::config::model::{
-    Arena, BoxEntity, CylinderEntity, Distribute, RobotEntity, Element, Entity, Euler, Floor,
-    FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose,
-    PositionMethod, TargetEntity, Vec3,
+    Arena, BoxEntity, CylinderEntity, Distribute, Element, Entity, Euler, Floor, FloorRegion,
+    FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose, PositionMethod,
+    RobotEntity, TargetEntity, Vec3,
 };
 use crate::config::registry::MediumKind;
-use crate::bodies::RobotKind;
 use crate::config::suggest::did_you_mean;
 use crate::messages::Rgb;
 
@@ -353,9 +353,8 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(max))
     });
     let camera_aperture_deg: Option<f64> = ctx.attr(el, "omnidirectional_camera_aperture");
-    let aperture_ok = camera_aperture_deg.is_none_or(|a| {
-        ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0))
-    });
+    let aperture_ok = camera_aperture_deg
+        .is_none_or(|a| ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0)));
     let mut controllers = el.children.iter().filter(|c| c.name == "controller");
     let controller = match (controllers.next(), controllers.next()) {
         (Some(c), None) => {
@@ -369,7 +368,10 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         (None, _) => {
             ctx.error(
                 el.location,
-                format!("<{}> needs a <controller config=\"controller id\"/>", el.name),
+                format!(
+                    "<{}> needs a <controller config=\"controller id\"/>",
+                    el.name
+                ),
                 None,
             );
             None

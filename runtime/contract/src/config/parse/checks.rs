@@ -173,7 +173,11 @@ fn controller_references(ctx: &mut Ctx, experiment: &Experiment) {
             .sensors
             .iter()
             .chain(&controller.actuators)
-            .filter_map(|d| d.body.filter(|&body| body != robot.kind).map(|body| (d, body)));
+            .filter_map(|d| {
+                d.body
+                    .filter(|&body| body != robot.kind)
+                    .map(|body| (d, body))
+            });
         for (device, body) in foreign {
             ctx.error(
                 device.location,

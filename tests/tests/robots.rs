@@ -1,0 +1,141 @@
+//! Robots beyond the e-puck, end to end with real processes: ARGoS' foot-bot example configurations run unchanged
+//! from any folder, and the ported foot-bot controllers behave as ARGoS' examples do.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+use swarm_system_tests::{
+    assert_clean, assert_nothing_left, follow_lines, spawn_swarm_in, swarm_in, wait_for_line,
+    wipe_runs, workspace_file,
+};
+
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("a temporary directory")
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json exists");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+/// Runs an ARGoS example from a folder that is not the workspace, as a user who keeps configs elsewhere does.
+fn run_example_elsewhere(example: &str, out: &Path, extra: &[&str]) {
+    let config = workspace_file(&format!("configs/argos_examples/{example}"));
+    let elsewhere = temp_dir();
+    let config = config.display().to_string();
+    let out_arg = out.display().to_string();
+    let mut args = vec!["run", &config, "--out", &out_arg, "--no-progress"];
+    args.extend_from_slice(extra);
+    let outcome = swarm_in(elsewhere.path(), &args);
+    assert!(
+        outcome.output.status.success(),
+        "swarm run {example} failed:\n{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+}
+
+/// Each robot's positions by tick, from `trajectory.csv`.
+fn positions(out: &Path) -> BTreeMap<u32, Vec<(u64, f64, f64)>> {
+    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (tick, robot, x, y) = (col("tick"), col("robot"), col("x"), col("y"));
+    let mut by_robot: BTreeMap<u32, Vec<(u64, f64, f64)>> = BTreeMap::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        by_robot
+            .entry(f[robot].parse().expect("robot"))
+            .or_default()
+            .push((
+                f[tick].parse().expect("tick"),
+                f[x].parse().expect("x"),
+                f[y].parse().expect("y"),
+            ));
+    }
+    by_robot
+}
+
+#[test]
+fn argos_footbot_examples_run_unchanged_from_any_folder() {
+    for (example, robots) in [("diffusion_1.argos", 1), ("diffusion_10.argos", 10)] {
+        let out = temp_dir();
+        run_example_elsewhere(example, out.path(), &["--ticks", "20"]);
+        let summary = summary(out.path());
+        assert_eq!(summary["robots"], robots, "{example}");
+        assert_eq!(summary["ticks"], 20, "{example}");
+    }
+}
+
+#[test]
+fn footbot_diffusion_keeps_every_robot_moving() {
+    let out = temp_dir();
+    run_example_elsewhere("diffusion_10.argos", out.path(), &["--ticks", "600"]);
+    let by_robot = positions(out.path());
+    assert_eq!(by_robot.len(), 10);
+    for (robot, track) in &by_robot {
+        // Over the second half of the minute: a robot that drove into a wall or another robot and stayed there
+        // would cover almost nothing; a diffusing one turns away and keeps going at 5 cm/s.
+        let late: f64 = track
+            .windows(2)
+            .filter(|w| w[0].0 >= 300)
+            .map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2))
+            .sum();
+        assert!(
+            late > 0.5,
+            "foot-bot {robot} covered only {late:.2} m in its last 30 s"
+        );
+    }
+}
+
+#[test]
+fn a_footbot_example_without_a_length_runs_until_interrupted() {
+    let out = temp_dir();
+    let elsewhere = temp_dir();
+    let config = workspace_file("configs/argos_examples/diffusion_1.argos");
+    let mut child = spawn_swarm_in(
+        elsewhere.path(),
+        &[
+            "run",
+            &config.display().to_string(),
+            "--no-progress",
+            "--out",
+            &out.path().display().to_string(),
+        ],
+    );
+    let pid = child.id();
+    let prefix = format!("sw{pid:x}-");
+    let lines = follow_lines(child.stderr.take());
+    let mut seen = Vec::new();
+    let ticked = wait_for_line(
+        &lines,
+        &mut seen,
+        "first tick completed",
+        std::time::Duration::from_secs(120),
+    );
+    if !ticked {
+        wipe_runs(&prefix);
+        let _ = child.kill();
+        panic!("the run never ticked:\n{}", seen.join("\n"));
+    }
+    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
+    let status = child.wait().expect("the launcher exits");
+    let rest: Vec<String> = lines.iter().collect();
+    assert_eq!(
+        status.code(),
+        Some(130),
+        "an interrupted run exits 130:\n{}\n{}",
+        seen.join("\n"),
+        rest.join("\n")
+    );
+    assert!(
+        seen.iter().any(|l| l.contains("it runs until Ctrl-C")),
+        "a length of 0 runs until interrupted, and says so:\n{}",
+        seen.join("\n")
+    );
+    assert_eq!(summary(out.path())["interrupted"], true);
+    assert_nothing_left(pid);
+}
