@@ -357,7 +357,7 @@ mod tests {
             err.to_string(),
             "unknown controller `footbot_flocking`: give `profile` and `supervisors` in <params>, or use one of: \
              epuck_obstacle_avoidance_sct_prob_controller, epuck_obstacleavoidance_controller, \
-             footbot_diffusion_controller, epuck_obstacleavoidance, footbot_diffusion"
+             footbot_diffusion_controller, epuck_obstacleavoidance, footbot_diffusion, disc_wander"
         );
     }
 }

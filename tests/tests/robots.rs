@@ -139,3 +139,84 @@ fn a_footbot_example_without_a_length_runs_until_interrupted() {
     assert_eq!(summary(out.path())["interrupted"], true);
     assert_nothing_left(pid);
 }
+
+/// Runs `config` (a workspace path) to completion into `out` from the workspace root.
+fn run_config(config: &Path, out: &Path, extra: &[&str]) {
+    let workspace = swarm_system_tests::workspace_root();
+    let config = config.display().to_string();
+    let out_arg = out.display().to_string();
+    let mut args = vec!["run", &config, "--out", &out_arg, "--no-progress"];
+    args.extend_from_slice(extra);
+    let outcome = swarm_in(&workspace, &args);
+    assert!(
+        outcome.output.status.success(),
+        "swarm run {config} failed:\n{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+}
+
+#[test]
+fn disc_robots_follow_velocity_commands_within_their_limits() {
+    // The example asks for 1 m/s and 10 rad/s: far beyond both bodies' limits.
+    let text = std::fs::read_to_string(workspace_file("configs/robots/disc_wander.argos"))
+        .expect("the disc robot example");
+    let original = r#"<params speed="0.2" turn_rate="1.5""#;
+    assert!(text.contains(original), "the example's params changed");
+    let dir = temp_dir();
+    let config = dir.path().join("fast.argos");
+    std::fs::write(
+        &config,
+        text.replace(original, r#"<params speed="1.0" turn_rate="10""#),
+    )
+    .expect("write the variant");
+    let out = temp_dir();
+    run_config(&config, out.path(), &["--ticks", "300"]);
+    let by_robot = positions(out.path());
+    assert_eq!(by_robot.len(), 8);
+    for (robot, track) in &by_robot {
+        // Robots 0-5 are scouts (0.22 m/s), 6-7 haulers (0.1 m/s); 10 ticks per second.
+        let limit = if *robot < 6 { 0.22 } else { 0.1 };
+        let speeds: Vec<f64> = track
+            .windows(2)
+            .map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2) * 10.0)
+            .collect();
+        let top = speeds.iter().copied().fold(0.0, f64::max);
+        // Contacts can push a robot a little faster than it drives; never anywhere near the 1 m/s asked for.
+        assert!(
+            top <= limit * 1.1,
+            "robot {robot} reached {top:.3} m/s, its limit is {limit}"
+        );
+        assert!(
+            top >= limit * 0.95,
+            "robot {robot} never drove at its limit {limit} (top {top:.3} m/s)"
+        );
+    }
+}
+
+#[test]
+fn a_mixed_swarm_runs_every_kind_with_its_own_controller() {
+    let out = temp_dir();
+    run_config(
+        &workspace_file("configs/robots/mixed.argos"),
+        out.path(),
+        &["--ticks", "100"],
+    );
+    let trajectory =
+        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    for id in ["ep0", "ep5", "fb0", "fb2", "disc0", "disc1"] {
+        assert!(
+            trajectory.contains(&format!(",{id},")),
+            "robot {id} is in the records"
+        );
+    }
+    let by_robot = positions(out.path());
+    assert_eq!(by_robot.len(), 11, "6 e-pucks, 3 foot-bots, 2 disc robots");
+    for (robot, track) in &by_robot {
+        let path: f64 = track
+            .windows(2)
+            .map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2))
+            .sum();
+        assert!(path > 0.2, "robot {robot} hardly moved ({path:.2} m)");
+    }
+}

@@ -4,7 +4,8 @@
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use swarm_contract::messages::{ActuatorCommand, GripperAction, PHEROMONE_CHANNELS};
+use swarm_contract::bodies::BodyModel;
+use swarm_contract::messages::{ActuatorCommand, Drive, GripperAction, PHEROMONE_CHANNELS};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{RobotId, TargetId, TargetState};
@@ -49,6 +50,17 @@ pub fn unicycle(wheels_cm_s: [f32; 2], inter_wheel_distance: f32) -> (f32, f32) 
     ((l + r) / 2.0, (r - l) / inter_wheel_distance)
 }
 
+/// The wheel speeds in cm/s that drive `body` at forward speed `twist[0]` m/s and turn rate `twist[1]` rad/s,
+/// each first clamped to the body's limits (non-finite values count as 0).
+pub fn twist_to_wheels(twist: [f32; 2], body: &BodyModel) -> [f32; 2] {
+    let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+    let max_v = body.max_wheel_speed_cm_s / 100.0;
+    let v = finite(twist[0]).clamp(-max_v, max_v);
+    let w = finite(twist[1]).clamp(-body.max_turn_rate, body.max_turn_rate);
+    let half = w * body.inter_wheel_distance / 2.0;
+    [(v - half) * 100.0, (v + half) * 100.0]
+}
+
 /// Applies `command` to robot `id`, or holds it still when `command` is `None` (no command, or dead).
 pub fn apply(
     arena: &mut Arena,
@@ -65,9 +77,19 @@ pub fn apply(
         arena.physics.drive(robot.handles.body, 0.0, 0.0);
         return;
     };
+    let commanded = match cmd.drive {
+        Drive::Wheels => cmd.wheels,
+        Drive::Twist => twist_to_wheels(cmd.twist, &robot.body),
+    };
+    // A twist within the limits may ask one wheel for more than the wheel limit (full speed while turning):
+    // the turn-rate limit, not the wheel limit, bounds it, as on a TurtleBot.
+    let max_wheel = match cmd.drive {
+        Drive::Wheels => robot.body.max_wheel_speed_cm_s,
+        Drive::Twist => f32::INFINITY,
+    };
     robot.wheels = wheel_speeds(
-        cmd.wheels,
-        robot.body.max_wheel_speed_cm_s,
+        commanded,
+        max_wheel,
         robot.devices.wheel_noise_std_dev,
         &mut robot.rng.wheels,
     );

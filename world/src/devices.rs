@@ -32,6 +32,17 @@ pub struct CameraOptions {
     pub noise_std_dev: f32,
 }
 
+/// Options of the range-finder ring.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RangeFinderOptions {
+    /// Number of rays, evenly spread from the heading counter-clockwise.
+    pub rays: u8,
+    /// Reach of each ray from the body centre, in metres.
+    pub range: f32,
+    /// Gaussian noise standard deviation on each hit distance, in metres.
+    pub noise_std_dev: f32,
+}
+
 /// The devices of one robot.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Devices {
@@ -43,6 +54,8 @@ pub struct Devices {
     pub ground: Option<f32>,
     /// Omnidirectional camera.
     pub camera: Option<CameraOptions>,
+    /// Range-finder ring.
+    pub range_finder: Option<RangeFinderOptions>,
     /// Range-and-bearing sensor and actuator.
     pub rab: Option<RabOptions>,
     /// Multiplicative Gaussian wheel noise `noise_std_dev` (0 = none).
@@ -62,6 +75,7 @@ impl Devices {
         light: Some(0.0),
         ground: Some(0.0),
         camera: Some(CameraOptions { noise_std_dev: 0.0 }),
+        range_finder: None,
         rab: Some(RabOptions {
             data_size: 2,
             loss_probability: 0.0,
@@ -80,6 +94,7 @@ impl Devices {
         light: None,
         ground: None,
         camera: None,
+        range_finder: None,
         rab: None,
         wheel_noise_std_dev: 0.0,
         gripper_reach: GRIPPER_REACH,

@@ -23,7 +23,7 @@ pub fn outline(entity: &Entity, position: Vec2, yaw: f32) -> Option<Placed> {
             radius: c.radius as f32,
         },
         Entity::Robot(r) => Shape::Disc {
-            radius: r.kind.body().radius,
+            radius: r.body().radius,
         },
         Entity::Target(t) => Shape::Disc {
             radius: t.radius as f32,

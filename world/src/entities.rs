@@ -53,7 +53,7 @@ pub struct Robot {
     /// The id from the configuration (`fb0`, `ep12`, ...).
     pub name: String,
     /// Its body: shape, wheels and sensor placement.
-    pub body: &'static BodyModel,
+    pub body: BodyModel,
     /// What its camera sees (the body's, unless the configuration sets another aperture).
     pub camera_view: CameraView,
     /// The controller id the configuration assigns.

@@ -9,10 +9,10 @@ use swarm_contract::bodies::RobotKind;
 use swarm_contract::config::{
     self, Controller, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
-use swarm_contract::messages::{PHEROMONE_CHANNELS, Rgb};
+use swarm_contract::messages::{MAX_RANGE_RAYS, PHEROMONE_CHANNELS, Rgb};
 
 use crate::actuators::GRIPPER_REACH;
-use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions};
+use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions, RangeFinderOptions};
 use crate::distribute::{self, outline};
 use crate::entities::{FloorRegion, Light};
 use crate::error::WorldError;
@@ -38,6 +38,13 @@ fn invalid(exp: &Experiment, location: Location, message: impl Into<String>) -> 
         message: message.into(),
     }
 }
+
+/// Rays of a `range_finder` that does not say (paper A's ring: one every 18 degrees).
+pub const DEFAULT_RANGE_RAYS: usize = 20;
+/// Reach in metres of a `range_finder` that does not say.
+pub const DEFAULT_RANGE_FINDER_RANGE: f64 = 1.0;
+/// Longest range-finder reach accepted, in metres.
+pub const MAX_RANGE_FINDER_RANGE: f64 = 100.0;
 
 /// ITU-R 601 luma of a colour as a grey level in [0, 1] (what ARGoS' ground sensors read).
 pub fn grey_level(c: Rgb) -> f32 {
@@ -98,6 +105,37 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
             })
         }
     };
+    let range_finder = match c.sensor(DeviceKind::RangeFinder) {
+        None => None,
+        Some(d) => {
+            let attr = |name: &str| {
+                d.attributes
+                    .parse::<f64>(name)
+                    .map_err(|e| invalid(exp, e.location, e.message))
+            };
+            let rays = attr("rays")?.unwrap_or(DEFAULT_RANGE_RAYS as f64);
+            if !(1.0..=MAX_RANGE_RAYS as f64).contains(&rays) || rays.fract() != 0.0 {
+                return Err(invalid(
+                    exp,
+                    d.location,
+                    format!("rays {rays} must be a whole number from 1 to {MAX_RANGE_RAYS}"),
+                ));
+            }
+            let range = attr("range")?.unwrap_or(DEFAULT_RANGE_FINDER_RANGE);
+            if !(range > 0.0 && range <= MAX_RANGE_FINDER_RANGE) {
+                return Err(invalid(
+                    exp,
+                    d.location,
+                    format!("range {range} must be above 0 and at most {MAX_RANGE_FINDER_RANGE} m"),
+                ));
+            }
+            Some(RangeFinderOptions {
+                rays: rays as u8,
+                range: range as f32,
+                noise_std_dev: d.noise_std_dev as f32,
+            })
+        }
+    };
     let gripper_reach = match c.actuator(DeviceKind::VirtualGripper) {
         None => GRIPPER_REACH,
         Some(d) => d
@@ -115,6 +153,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
             .map(|d| CameraOptions {
                 noise_std_dev: d.noise_std_dev as f32,
             }),
+        range_finder,
         rab,
         wheel_noise_std_dev: c
             .actuator(DeviceKind::Wheels)
@@ -328,7 +367,7 @@ fn add_entity(
                 }
                 rab.data_size = size as u8;
             }
-            let id = b.robot_of_kind(e.kind, &e.id, &e.controller, position, yaw, devices);
+            let id = b.robot_with_body(e.body(), &e.id, &e.controller, position, yaw, devices);
             if let Some(range) = e.rab_range {
                 b.rab_range(id, range as f32);
             }

@@ -25,6 +25,8 @@ pub enum Purpose {
     Rab = 6,
     /// Camera blob position noise.
     Camera = 7,
+    /// Range-finder distance noise.
+    RangeFinder = 8,
 }
 
 /// The stream for `purpose` and `index` (a robot index, or 0 for world-wide purposes) of the run `seed`.
@@ -49,6 +51,8 @@ pub struct RobotStreams {
     pub rab: ChaCha8Rng,
     /// Camera noise.
     pub camera: ChaCha8Rng,
+    /// Range-finder noise.
+    pub range_finder: ChaCha8Rng,
 }
 
 impl RobotStreams {
@@ -61,6 +65,7 @@ impl RobotStreams {
             wheels: stream(seed, Purpose::Wheels, robot),
             rab: stream(seed, Purpose::Rab, robot),
             camera: stream(seed, Purpose::Camera, robot),
+            range_finder: stream(seed, Purpose::RangeFinder, robot),
         }
     }
 }

@@ -6,7 +6,7 @@
 //! [`World::act_and_step`] only reuses buffers around the rapier2d step (which allocates a few small buffers of its
 //! own per step).
 
-use swarm_contract::bodies::{CameraView, RobotKind};
+use swarm_contract::bodies::{BodyModel, CameraView, EPUCK};
 use swarm_contract::config::Experiment;
 use swarm_contract::config::faults::DeadBodies;
 use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
@@ -27,7 +27,7 @@ use crate::media::rab::RabMedium;
 use crate::physics::{Motion, Physics};
 use crate::rng::RobotStreams;
 use crate::scene::Scene;
-use crate::sensors::{Observer, camera, ground, light, proximity, rab};
+use crate::sensors::{Observer, camera, ground, light, proximity, rab, range_finder};
 
 /// Default range of an e-puck's range-and-bearing emitter in metres (each body has its own).
 pub const DEFAULT_RAB_RANGE: f32 = swarm_contract::bodies::EPUCK.rab_range;
@@ -80,20 +80,13 @@ impl WorldBuilder {
         heading: f32,
         devices: Devices,
     ) -> RobotId {
-        self.robot_of_kind(
-            RobotKind::EPuck,
-            name,
-            controller,
-            position,
-            heading,
-            devices,
-        )
+        self.robot_with_body(EPUCK, name, controller, position, heading, devices)
     }
 
-    /// Adds a robot of `kind` at `position` facing `heading` radians.
-    pub fn robot_of_kind(
+    /// Adds a robot with `body` at `position` facing `heading` radians.
+    pub fn robot_with_body(
         &mut self,
-        kind: RobotKind,
+        body: BodyModel,
         name: &str,
         controller: &str,
         position: Vec2,
@@ -101,7 +94,6 @@ impl WorldBuilder {
         devices: Devices,
     ) -> RobotId {
         let id = RobotId(self.arena.robots.len() as u32);
-        let body = kind.body();
         let handles = self.arena.physics.add_robot(
             body.radius,
             body.mass,
@@ -376,7 +368,7 @@ impl World {
             frame.alive = 1;
             frame.camera_len = 0;
             frame.rab_len = 0;
-            let (pos, heading, body) = (robot.position, robot.heading, robot.body);
+            let (pos, heading, body) = (robot.position, robot.heading, &robot.body);
             let observer = Observer {
                 me,
                 position: pos,
@@ -417,6 +409,18 @@ impl World {
                     level,
                     &mut robot.rng.ground,
                     &mut frame.ground[..n],
+                );
+            }
+            if let Some(opts) = &devices.range_finder {
+                let n = usize::from(opts.rays);
+                frame.ranges_len = opts.rays;
+                range_finder::sense(
+                    &self.scene,
+                    observer,
+                    opts,
+                    &mut robot.rng.range_finder,
+                    &mut self.scratch,
+                    &mut frame.ranges[..n],
                 );
             }
             if let Some(opts) = &devices.camera {

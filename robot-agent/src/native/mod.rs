@@ -1,6 +1,7 @@
 //! Native controllers: hand-written control steps that need no supervisors, registered under the names configs
 //! use for them.
 
+pub mod disc_wander;
 pub mod epuck_obstacleavoidance;
 pub mod footbot_diffusion;
 
@@ -8,6 +9,7 @@ use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
 
 use crate::params::{ParamError, Params};
+use disc_wander::DiscWander;
 use epuck_obstacleavoidance::EpuckObstacleAvoidance;
 use footbot_diffusion::FootbotDiffusion;
 
@@ -29,6 +31,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (FootbotDiffusion::NAME, |p| {
         Ok(Box::new(FootbotDiffusion::from_params(p)?))
+    }),
+    (DiscWander::NAME, |p| {
+        Ok(Box::new(DiscWander::from_params(p)?))
     }),
 ];
 

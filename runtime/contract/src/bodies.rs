@@ -6,7 +6,9 @@
 //!
 //! The e-puck follows the IRIDIA model (docs/epuck-and-world.md). The foot-bot follows the numbers ARGoS gives
 //! its foot-bot (docs/robots.md): a 0.085 m disc, wheels 0.14 m apart, 24 proximity and 24 light sensors on one
-//! ring starting 7.5 degrees left of the heading, four motor-ground sensors under the wheel axis.
+//! ring starting 7.5 degrees left of the heading, four motor-ground sensors under the wheel axis. The disc robot
+//! is a configurable differential-drive body for the related methods' robots, by default TurtleBot3-like
+//! (radius 0.105 m, 0.22 m/s, 2.84 rad/s); it senses with a range-finder ring, not with IR rings.
 
 use crate::messages::{MAX_GROUND_SENSORS, MAX_LIGHT_SENSORS, MAX_PROXIMITY_SENSORS};
 
@@ -17,17 +19,20 @@ pub enum RobotKind {
     EPuck,
     /// ARGoS' foot-bot, `<foot-bot>`.
     FootBot,
+    /// A configurable differential-drive disc, `<disc-robot>` (defaults: [`DISC`]).
+    Disc,
 }
 
 impl RobotKind {
     /// Every kind, in configuration-element order.
-    pub const ALL: [RobotKind; 2] = [RobotKind::EPuck, RobotKind::FootBot];
+    pub const ALL: [RobotKind; 3] = [RobotKind::EPuck, RobotKind::FootBot, RobotKind::Disc];
 
     /// The configuration element that places such a robot.
     pub fn tag(self) -> &'static str {
         match self {
             RobotKind::EPuck => "e-puck",
             RobotKind::FootBot => "foot-bot",
+            RobotKind::Disc => "disc-robot",
         }
     }
 
@@ -36,11 +41,12 @@ impl RobotKind {
         Self::ALL.into_iter().find(|k| k.tag() == tag)
     }
 
-    /// The body of this kind.
+    /// The body of this kind (for the disc robot: its defaults, which a configuration may change).
     pub fn body(self) -> &'static BodyModel {
         match self {
             RobotKind::EPuck => &EPUCK,
             RobotKind::FootBot => &FOOTBOT,
+            RobotKind::Disc => &DISC,
         }
     }
 }
@@ -77,8 +83,12 @@ pub struct BodyModel {
     pub mass: f32,
     /// Distance between the wheel contact points in metres.
     pub inter_wheel_distance: f32,
-    /// Largest wheel speed in cm/s; commands beyond it are clamped.
+    /// Largest wheel speed in cm/s; wheel commands beyond it are clamped, and so are velocity commands' forward
+    /// speeds.
     pub max_wheel_speed_cm_s: f32,
+    /// Largest turn rate in rad/s of a velocity command (turning on the spot at full wheel speed is
+    /// `2 max_wheel_speed / inter_wheel_distance`).
+    pub max_turn_rate: f32,
     /// Height of the LEDs the cameras of other robots see, in metres.
     pub led_height: f32,
     /// Proximity sensor angles in degrees, counter-clockwise from the heading, in reading order.
@@ -160,6 +170,7 @@ pub const EPUCK: BodyModel = BodyModel {
     mass: 0.2,
     inter_wheel_distance: 0.053,
     max_wheel_speed_cm_s: 12.8,
+    max_turn_rate: 2.0 * 0.128 / 0.053,
     led_height: 0.086,
     proximity_angles_deg: &EPUCK_SENSOR_ANGLES_DEG,
     proximity_mount_radius: 0.035,
@@ -184,6 +195,7 @@ pub const FOOTBOT: BodyModel = BodyModel {
     mass: 1.6,
     inter_wheel_distance: 0.14,
     max_wheel_speed_cm_s: 30.0,
+    max_turn_rate: 2.0 * 0.3 / 0.14,
     led_height: 0.085,
     proximity_angles_deg: &FOOTBOT_SENSOR_ANGLES_DEG,
     proximity_mount_radius: 0.085_036_76,
@@ -200,6 +212,33 @@ pub const FOOTBOT: BodyModel = BodyModel {
     camera_height: 0.288_699_73,
     camera_view: CameraView::Aperture(70.0f32.to_radians()),
     rab_height: 0.1,
+    rab_range: 3.0,
+    rab_data_size: 10,
+    rab_range_between_surfaces: false,
+};
+
+/// The disc robot's defaults: a TurtleBot3 Burger-like body (radius 0.105 m, 0.192 m tall, 1 kg, wheels 0.16 m
+/// apart, 0.22 m/s, 2.84 rad/s). No IR rings, ground sensors or camera; an LED on top; range-and-bearing as
+/// ARGoS' generic device (3 m, 10 bytes, centre-to-centre ranges). It senses with `range_finder`.
+pub const DISC: BodyModel = BodyModel {
+    kind: RobotKind::Disc,
+    radius: 0.105,
+    height: 0.192,
+    mass: 1.0,
+    inter_wheel_distance: 0.16,
+    max_wheel_speed_cm_s: 22.0,
+    max_turn_rate: 2.84,
+    led_height: 0.192,
+    proximity_angles_deg: &[],
+    proximity_mount_radius: 0.105,
+    proximity_range: 0.0,
+    proximity_curve: ProximityCurve::FootBot,
+    light_angles_deg: &[],
+    light_height: 0.0,
+    ground_offsets: &[],
+    camera_height: 0.0,
+    camera_view: CameraView::Disc(0.0),
+    rab_height: 0.192,
     rab_range: 3.0,
     rab_data_size: 10,
     rab_range_between_surfaces: false,

@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 2;
+pub const MESSAGE_VERSION: u32 = 3;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -25,6 +25,8 @@ pub const MAX_PROXIMITY_SENSORS: usize = 24;
 pub const MAX_LIGHT_SENSORS: usize = 24;
 /// Most ground sensors a body has (the foot-bot's four motor-ground sensors; the e-puck has 3).
 pub const MAX_GROUND_SENSORS: usize = 4;
+/// Most rays of a range-finder ring (paper A's robots use 20, 18 degrees apart).
+pub const MAX_RANGE_RAYS: usize = 32;
 /// Most LED blobs the omnidirectional camera reports per tick; further blobs (farthest first) are dropped.
 pub const MAX_CAMERA_BLOBS: usize = 16;
 /// Most range-and-bearing messages a robot receives per tick; further messages (farthest first) are dropped.
@@ -116,6 +118,11 @@ pub struct SensorFrame {
     /// Ground readings in [0, 1] (1 white, 0 black), in the body's ground-sensor order (e-puck: index 0 is the
     /// left sensor).
     pub ground: [f32; MAX_GROUND_SENSORS],
+    /// Number of valid entries in `ranges` (the range finder's ray count; 0 when it is not declared).
+    pub ranges_len: u8,
+    /// Range-finder readings: metres from the body centre to the nearest body along ray i (ray i at
+    /// `360 i / ranges_len` degrees counter-clockwise from the heading), or infinity when nothing is within range.
+    pub ranges: [f32; MAX_RANGE_RAYS],
     /// Number of valid entries in `camera`.
     pub camera_len: u8,
     /// LED blobs seen by the omnidirectional camera, nearest first.
@@ -148,6 +155,8 @@ impl SensorFrame {
             light: [0.0; MAX_LIGHT_SENSORS],
             ground_len: 0,
             ground: [1.0; MAX_GROUND_SENSORS],
+            ranges_len: 0,
+            ranges: [f32::INFINITY; MAX_RANGE_RAYS],
             camera_len: 0,
             camera: [CameraBlob::default(); MAX_CAMERA_BLOBS],
             rab_len: 0,
@@ -194,6 +203,11 @@ impl SensorFrame {
         &self.ground[..usize::from(self.ground_len).min(MAX_GROUND_SENSORS)]
     }
 
+    /// The valid range-finder readings.
+    pub fn range_readings(&self) -> &[f32] {
+        &self.ranges[..usize::from(self.ranges_len).min(MAX_RANGE_RAYS)]
+    }
+
     /// The valid camera blobs.
     pub fn camera_blobs(&self) -> &[CameraBlob] {
         &self.camera[..usize::from(self.camera_len).min(MAX_CAMERA_BLOBS)]
@@ -203,6 +217,18 @@ impl SensorFrame {
     pub fn rab_messages(&self) -> &[RabMessage] {
         &self.rab[..usize::from(self.rab_len).min(MAX_RAB_MESSAGES)]
     }
+}
+
+/// How the wheels are commanded this tick.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub enum Drive {
+    /// Left and right wheel speeds in cm/s (`ActuatorCommand::wheels`), each clamped to the body's limit.
+    #[default]
+    Wheels = 0,
+    /// Forward speed in m/s and turn rate in rad/s (`ActuatorCommand::twist`), each clamped to the body's limit
+    /// (as a TurtleBot's `cmd_vel`).
+    Twist = 1,
 }
 
 /// What the virtual gripper should do this tick.
@@ -266,8 +292,12 @@ pub struct ActuatorCommand {
     pub tick: u64,
     /// Index of the robot in the run.
     pub robot: u32,
+    /// Which of `wheels` and `twist` drives the robot.
+    pub drive: Drive,
     /// Left and right wheel speeds in cm/s (the world clamps them to the robot's limit).
     pub wheels: [f32; 2],
+    /// Forward speed in m/s and turn rate in rad/s, counter-clockwise positive (used when `drive` is `Twist`).
+    pub twist: [f32; 2],
     /// LED colour.
     pub led: Rgb,
     /// Number of range-and-bearing payload bytes to broadcast this tick (0 = send nothing).
@@ -287,12 +317,20 @@ pub struct ActuatorCommand {
 }
 
 impl ActuatorCommand {
+    /// Commands forward speed `v` (m/s) and turn rate `w` (rad/s) instead of wheel speeds.
+    pub fn set_twist(&mut self, v: f32, w: f32) {
+        self.drive = Drive::Twist;
+        self.twist = [v, w];
+    }
+
     /// The command of a robot that does nothing: wheels stopped, LEDs off.
     pub fn idle(robot: u32, tick: u64) -> Self {
         Self {
             tick,
             robot,
+            drive: Drive::Wheels,
             wheels: [0.0; 2],
+            twist: [0.0; 2],
             led: Rgb::OFF,
             rab_len: 0,
             rab_payload: [0; RAB_PAYLOAD_BYTES],

@@ -8,6 +8,7 @@ pub mod light;
 pub mod noise;
 pub mod proximity;
 pub mod rab;
+pub mod range_finder;
 
 use swarm_contract::bodies::BodyModel;
 
@@ -15,9 +16,9 @@ use crate::geometry::Vec2;
 
 /// The robot a sensor reads for: its index (robots are the first bodies of the scene), its pose and its body.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Observer {
+pub struct Observer<'a> {
     /// Its body: where its sensors sit.
-    pub body: &'static BodyModel,
+    pub body: &'a BodyModel,
     /// Robot index, equal to its scene index.
     pub me: u32,
     /// Position of the point between the wheels.
@@ -26,7 +27,7 @@ pub struct Observer {
     pub heading: f32,
 }
 
-impl Observer {
+impl Observer<'_> {
     /// A point given in the robot frame (x forward, y left), in the arena frame.
     pub fn to_arena(&self, local: Vec2) -> Vec2 {
         let (s, c) = self.heading.sin_cos();

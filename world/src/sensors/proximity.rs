@@ -63,6 +63,7 @@ fn sensor_directions(body: &BodyModel, argos_uniform_ring: bool) -> &'static [Ve
         (RobotKind::EPuck, false) => &TABLES[0],
         (RobotKind::EPuck, true) => &TABLES[1],
         (RobotKind::FootBot, _) => &TABLES[2],
+        (RobotKind::Disc, _) => &[],
     }
 }
 

@@ -86,6 +86,7 @@ pub fn epuck(id: &str, line: u32) -> Entity {
         rab_range: None,
         rab_data_size: None,
         camera_aperture_deg: None,
+        shape: DiscShape::default(),
         location: at(line),
     })
 }

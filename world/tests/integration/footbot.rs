@@ -1,7 +1,7 @@
 //! The foot-bot's body and sensors against analytic geometry, with the numbers of docs/robots.md.
 
 use crate::common::{builder, drive, frames, wall, wheels};
-use swarm_contract::bodies::{FOOTBOT, RobotKind};
+use swarm_contract::bodies::FOOTBOT;
 use swarm_contract::messages::Rgb;
 use swarm_world::devices::Devices;
 use swarm_world::entities::{FloorRegion, Light};
@@ -12,14 +12,7 @@ use swarm_world::sensors::proximity::footbot_curve;
 const R: f32 = FOOTBOT.radius;
 
 fn footbot_at(b: &mut swarm_world::WorldBuilder, position: Vec2, heading: f32) {
-    b.robot_of_kind(
-        RobotKind::FootBot,
-        "fb",
-        "c",
-        position,
-        heading,
-        Devices::ALL,
-    );
+    b.robot_with_body(FOOTBOT, "fb", "c", position, heading, Devices::ALL);
 }
 
 /// Distance along a ray leaving the body edge at `angle_deg` to a wall whose face is `d` ahead of the edge.

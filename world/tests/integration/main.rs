@@ -6,6 +6,7 @@ mod common;
 
 mod actuators;
 mod config;
+mod disc;
 mod footbot;
 mod run;
 mod sensors;

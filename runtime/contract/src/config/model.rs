@@ -13,7 +13,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use crate::bodies::RobotKind;
+use crate::bodies::{BodyModel, RobotKind};
 use crate::messages::Rgb;
 
 use super::diagnostic::Diagnostic;
@@ -335,6 +335,9 @@ pub enum DeviceKind {
     OmnidirectionalCamera,
     /// Range-and-bearing: `epuck_range_and_bearing`, `range_and_bearing` (sensor and actuator).
     RangeAndBearing,
+    /// A ring of range-finder rays from the body centre (our `range_finder`, sensor; attributes `rays` and
+    /// `range`).
+    RangeFinder,
     /// Absolute pose: `positioning` (sensor).
     Positioning,
     /// Our virtual gripper (thesis section "gripper"): `virtual_gripper` (sensor: holding state; actuator: grip).
@@ -484,7 +487,7 @@ pub enum Entity {
     Box(BoxEntity),
     /// `<cylinder>`.
     Cylinder(CylinderEntity),
-    /// A robot: `<e-puck>` or `<foot-bot>`.
+    /// A robot: `<e-puck>`, `<foot-bot>` or `<disc-robot>`.
     Robot(RobotEntity),
     /// `<light>`.
     Light(LightEntity),
@@ -605,8 +608,9 @@ pub struct Led {
     pub location: Location,
 }
 
-/// `<e-puck id [rab_range] [rab_data_size]>` or `<foot-bot id [rab_range] [rab_data_size]
-/// [omnidirectional_camera_aperture]>`, with `<controller config>`.
+/// `<e-puck id [rab_range] [rab_data_size]>`, `<foot-bot id [rab_range] [rab_data_size]
+/// [omnidirectional_camera_aperture]>` or `<disc-robot id [rab_range] [rab_data_size] [radius] [height] [mass]
+/// [wheel_base] [max_speed] [max_turn_rate]>`, with `<controller config>`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotEntity {
     /// Which robot the element places.
@@ -621,8 +625,53 @@ pub struct RobotEntity {
     pub rab_data_size: Option<u32>,
     /// `omnidirectional_camera_aperture` in degrees (foot-bot), if given.
     pub camera_aperture_deg: Option<f64>,
+    /// The disc robot's body attributes (all `None` for the e-puck and the foot-bot, whose bodies are fixed).
+    pub shape: DiscShape,
     /// Where the element is.
     pub location: Location,
+}
+
+impl RobotEntity {
+    /// The robot's body: its kind's, with the disc robot's attributes applied.
+    pub fn body(&self) -> BodyModel {
+        let mut body = *self.kind.body();
+        let s = &self.shape;
+        let set = |field: &mut f32, value: Option<f64>| {
+            if let Some(v) = value {
+                *field = v as f32;
+            }
+        };
+        set(&mut body.radius, s.radius);
+        set(&mut body.proximity_mount_radius, s.radius);
+        set(&mut body.height, s.height);
+        set(&mut body.led_height, s.height);
+        set(&mut body.rab_height, s.height);
+        set(&mut body.mass, s.mass);
+        set(&mut body.inter_wheel_distance, s.wheel_base);
+        set(
+            &mut body.max_wheel_speed_cm_s,
+            s.max_speed.map(|v| v * 100.0),
+        );
+        set(&mut body.max_turn_rate, s.max_turn_rate);
+        body
+    }
+}
+
+/// The attributes of a `<disc-robot>` that change its body from the defaults (`bodies::DISC`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DiscShape {
+    /// `radius` in metres.
+    pub radius: Option<f64>,
+    /// `height` in metres.
+    pub height: Option<f64>,
+    /// `mass` in kg.
+    pub mass: Option<f64>,
+    /// `wheel_base`: distance between the wheels in metres.
+    pub wheel_base: Option<f64>,
+    /// `max_speed`: largest wheel and forward speed in m/s.
+    pub max_speed: Option<f64>,
+    /// `max_turn_rate`: largest turn rate of a velocity command in rad/s.
+    pub max_turn_rate: Option<f64>,
 }
 
 /// `<light id position orientation color intensity medium>`; its position is the [`PlacedEntity`] pose.

@@ -2,7 +2,7 @@
 //!
 //! Names are registry keys (as in ARGoS): the `.argos` element name finds the entry here. Both e-puck plug-ins'
 //! names are accepted (docs/epuck-and-world.md section 4.2), the foot-bot's (`footbot_proximity`, `footbot_light`,
-//! `footbot_motor_ground`), plus ours: `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
+//! `footbot_motor_ground`), plus ours: `range_finder`, `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
 //! name (`epuck_*`, `footbot_*`) is refused on a robot of another kind.
 
 use super::model::{DeviceKind, DeviceRole};
@@ -219,6 +219,14 @@ pub(crate) const DEVICES: &[Entry] = &[
         medium: None,
         attributes: &[],
         body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "range_finder",
+        role: S,
+        kind: K::RangeFinder,
+        medium: None,
+        attributes: &["rays", "range"],
+        body: None,
     },
     Entry {
         name: "positioning",

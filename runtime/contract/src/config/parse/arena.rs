@@ -1,22 +1,32 @@
-//! `<arena>`: entities (box, cylinder, e-puck, foot-bot, light, our target), the floor, and `<distribute>` blocks.
+//! `<arena>`: entities (box, cylinder, e-puck, foot-bot, our disc robot and target, light), the floor, and
+//! `<distribute>` blocks.
 
 use super::{Ctx, MediumRef};
 use crate::bodies::RobotKind;
 use crate::config::model::{
-    Arena, BoxEntity, CylinderEntity, Distribute, Element, Entity, Euler, Floor, FloorRegion,
-    FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose, PositionMethod,
-    RobotEntity, TargetEntity, Vec3,
+    Arena, BoxEntity, CylinderEntity, DiscShape, Distribute, Element, Entity, Euler, Floor,
+    FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose,
+    PositionMethod, RobotEntity, TargetEntity, Vec3,
 };
 use crate::config::registry::MediumKind;
 use crate::config::suggest::did_you_mean;
 use crate::messages::Rgb;
 
-const ENTITIES: &[&str] = &["box", "cylinder", "e-puck", "foot-bot", "light", "target"];
+const ENTITIES: &[&str] = &[
+    "box",
+    "cylinder",
+    "e-puck",
+    "foot-bot",
+    "disc-robot",
+    "light",
+    "target",
+];
 const ARENA_CHILDREN: &[&str] = &[
     "box",
     "cylinder",
     "e-puck",
     "foot-bot",
+    "disc-robot",
     "light",
     "target",
     "floor",
@@ -91,7 +101,7 @@ pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
             name if UNSUPPORTED_ENTITIES.contains(&name) => {
                 ctx.error(
                     child.location,
-                    format!("entity <{name}> is not supported: the world simulates e-pucks and foot-bots"),
+                    format!("entity <{name}> is not supported: the world simulates e-pucks, foot-bots and <disc-robot>s"),
                     None,
                 );
             }
@@ -128,7 +138,7 @@ fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<En
         name => {
             let children: &[&str] = match name {
                 "box" | "cylinder" => &["body", "leds"],
-                "e-puck" | "foot-bot" => &["body", "controller"],
+                "e-puck" | "foot-bot" | "disc-robot" => &["body", "controller"],
                 _ => &["body"],
             };
             let mut body: Option<&Element> = None;
@@ -325,11 +335,40 @@ const IGNORED_FOOTBOT_ATTRIBUTES: &[&str] = &[
     "perspective_camera_range",
 ];
 
-/// `<e-puck>` or `<foot-bot>`: id, range-and-bearing options, the foot-bot's camera aperture, `<controller>`.
+/// The `<disc-robot>` body attributes, each positive and finite.
+const DISC_ATTRIBUTES: &[&str] = &[
+    "radius",
+    "height",
+    "mass",
+    "wheel_base",
+    "max_speed",
+    "max_turn_rate",
+];
+
+/// `<e-puck>`, `<foot-bot>` or `<disc-robot>`: id, range-and-bearing options, the foot-bot's camera aperture, the
+/// disc robot's body, `<controller>`.
 fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let kind = RobotKind::from_tag(&el.name)?;
     let body = kind.body();
     let mut known = vec!["id", "rab_range", "rab_data_size"];
+    let mut shape = DiscShape::default();
+    let mut shape_ok = true;
+    if kind == RobotKind::Disc {
+        known.extend_from_slice(DISC_ATTRIBUTES);
+        for (name, field) in DISC_ATTRIBUTES.iter().zip([
+            &mut shape.radius,
+            &mut shape.height,
+            &mut shape.mass,
+            &mut shape.wheel_base,
+            &mut shape.max_speed,
+            &mut shape.max_turn_rate,
+        ]) {
+            if el.attributes.contains_key(*name) {
+                *field = ctx.positive(el, name);
+                shape_ok &= field.is_some();
+            }
+        }
+    }
     if kind == RobotKind::FootBot {
         known.push("omnidirectional_camera_aperture");
         known.extend_from_slice(IGNORED_FOOTBOT_ATTRIBUTES);
@@ -377,7 +416,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
             None
         }
     };
-    (rab_range_ok && rab_data_size_ok && aperture_ok).then_some(())?;
+    (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok).then_some(())?;
     Some(RobotEntity {
         kind,
         id: id?,
@@ -385,6 +424,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         rab_range,
         rab_data_size,
         camera_aperture_deg,
+        shape,
         location: el.location,
     })
 }
