@@ -24,7 +24,7 @@ fn ray_distance_to_face(d: f32, angle_deg: f32) -> f32 {
 #[test]
 fn footbot_curve_is_one_at_contact_and_a_tenth_at_its_range() {
     assert_eq!(footbot_curve(0.005), 1.0);
-    assert!((footbot_curve(0.1) - 0.0100527 / 0.100163144).abs() < 1e-6);
+    assert!((footbot_curve(0.1) - 0.010_052_7 / (0.1 + 0.000_163_144)).abs() < 1e-6);
     assert!((footbot_curve(0.1) - 0.1).abs() < 1e-3);
     assert_eq!(footbot_curve(0.1001), 0.0);
 }
