@@ -135,7 +135,7 @@ pub fn build(
             })
         }
         Plan::Native { name } => {
-            let controller = native::build_native(name, params)?;
+            let controller = native::build_native(name, &params.clone().with_run_seed(run_seed))?;
             info!(native = name.as_str(), "native controller built");
             Ok(Control::Native(controller))
         }

@@ -102,6 +102,18 @@ const BUILTINS: &[Builtin] = &[
             name: native::footbot_diffusion::FootbotDiffusion::NAME.to_owned(),
         },
     },
+    Builtin {
+        element: "footbot_flocking_controller",
+        plan: || Plan::Native {
+            name: native::footbot_flocking::FootbotFlocking::NAME.to_owned(),
+        },
+    },
+    Builtin {
+        element: "footbot_synchronization_controller",
+        plan: || Plan::Native {
+            name: native::footbot_synchronization::FootbotSynchronization::NAME.to_owned(),
+        },
+    },
 ];
 
 /// Why a controller element does not name something this agent can run.
@@ -352,12 +364,13 @@ mod tests {
 
     #[test]
     fn unknown_element_lists_the_known_names() {
-        let err = plan("footbot_flocking", &Params::default(), Path::new("/c")).unwrap_err();
+        let err = plan("footbot_nn_controller", &Params::default(), Path::new("/c")).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "unknown controller `footbot_flocking`: give `profile` and `supervisors` in <params>, or use one of: \
-             epuck_obstacle_avoidance_sct_prob_controller, epuck_obstacleavoidance_controller, \
-             footbot_diffusion_controller, epuck_obstacleavoidance, footbot_diffusion, disc_wander"
+            "unknown controller `footbot_nn_controller`: give `profile` and `supervisors` in <params>, or use one \
+             of: epuck_obstacle_avoidance_sct_prob_controller, epuck_obstacleavoidance_controller, \
+             footbot_diffusion_controller, footbot_flocking_controller, footbot_synchronization_controller, \
+             epuck_obstacleavoidance, footbot_diffusion, footbot_flocking, footbot_synchronization, disc_wander"
         );
     }
 }

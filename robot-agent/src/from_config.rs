@@ -1,8 +1,9 @@
 //! Choosing a robot's controller from a parsed experiment, with errors located in the `.argos` file.
 //!
-//! A robot's controller is the one its `<e-puck>` names, found by the robot's index in the canonical order
-//! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes become the [`Params`] of its profile or native
-//! controller, and relative paths in them resolve against the configuration's folder.
+//! A robot's controller is the one its robot element names, found by the robot's index in the canonical order
+//! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes
+//! (and its children's, as `child.attribute`) become the [`Params`] of its profile or native controller, and
+//! relative paths in them resolve against the configuration's folder.
 
 use std::path::Path;
 
@@ -59,15 +60,22 @@ pub fn controller_by_id<'a>(
     })
 }
 
-/// The `<params>` attributes of `controller`.
+/// The `<params>` attributes of `controller`, and each child element's as `child.attribute` (ARGoS controllers
+/// such as the foot-bot flocking example group theirs in children: `<wheel_turning max_speed="10"/>` gives
+/// `wheel_turning.max_speed`).
 pub fn params_of(controller: &Controller) -> Params {
-    Params::new(
-        controller
-            .params
+    let own = controller
+        .params
+        .attributes
+        .iter()
+        .map(|(name, attribute)| (name.clone(), attribute.value.clone()));
+    let children = controller.params.children.iter().flat_map(|child| {
+        child
             .attributes
             .iter()
-            .map(|(name, attribute)| (name.clone(), attribute.value.clone())),
-    )
+            .map(|(name, attribute)| (format!("{}.{name}", child.name), attribute.value.clone()))
+    });
+    Params::new(own.chain(children))
 }
 
 /// Plans and builds `controller` of `experiment` for robot `robot` of a run seeded with `run_seed`; any failure

@@ -220,3 +220,110 @@ fn a_mixed_swarm_runs_every_kind_with_its_own_controller() {
         assert!(path > 0.2, "robot {robot} hardly moved ({path:.2} m)");
     }
 }
+
+/// The LED ring's red component per robot per tick, from `trajectory.csv`: the ticks at which each robot
+/// flashed.
+fn flash_ticks(out: &Path) -> BTreeMap<u64, Vec<u32>> {
+    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (tick, robot, red) = (col("tick"), col("robot"), col("led_r"));
+    let mut flashes: BTreeMap<u64, Vec<u32>> = BTreeMap::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        if f[red] == "255" {
+            flashes
+                .entry(f[tick].parse().expect("tick"))
+                .or_default()
+                .push(f[robot].parse().expect("robot"));
+        }
+    }
+    flashes
+}
+
+#[test]
+fn footbot_flocking_moves_the_group_towards_the_light_together() {
+    let out = temp_dir();
+    run_example_elsewhere("flocking.argos", out.path(), &["--ticks", "1200"]);
+    let by_robot = positions(out.path());
+    assert_eq!(by_robot.len(), 10);
+    let light = (8.9, 2.7);
+    let at = |tick: u64| -> Vec<(f64, f64)> {
+        by_robot
+            .values()
+            .map(|track| {
+                let row = track
+                    .iter()
+                    .find(|r| r.0 == tick)
+                    .expect("every tick is recorded");
+                (row.1, row.2)
+            })
+            .collect()
+    };
+    let centroid = |p: &[(f64, f64)]| {
+        let n = p.len() as f64;
+        (
+            p.iter().map(|q| q.0).sum::<f64>() / n,
+            p.iter().map(|q| q.1).sum::<f64>() / n,
+        )
+    };
+    let (start, end) = (at(0), at(1200));
+    let dist = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).hypot(a.1 - b.1);
+    let (c0, c1) = (centroid(&start), centroid(&end));
+    assert!(
+        dist(c1, light) < dist(c0, light) - 2.0,
+        "the group's centre went from {:.2} m to {:.2} m from the light",
+        dist(c0, light),
+        dist(c1, light)
+    );
+    let spread = end.iter().map(|&p| dist(p, c1)).fold(0.0, f64::max);
+    assert!(
+        spread < 2.0,
+        "the group fell apart: a robot is {spread:.2} m from its centre"
+    );
+    let closest = end
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &a)| end[i + 1..].iter().map(move |&b| dist(a, b)))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        closest > 0.4,
+        "flocking keeps neighbours near the 0.75 m target distance, not piled up ({closest:.2} m)"
+    );
+}
+
+#[test]
+fn footbot_synchronization_converges_to_one_flash_per_period() {
+    let out = temp_dir();
+    run_example_elsewhere("synchronization.argos", out.path(), &["--ticks", "3000"]);
+    let flashes = flash_ticks(out.path());
+    // Group the flashes into bursts of consecutive ticks.
+    let mut bursts: Vec<(u64, u64, usize)> = Vec::new();
+    for (&tick, robots) in &flashes {
+        match bursts.last_mut() {
+            Some((_, last, count)) if tick <= *last + 1 => {
+                *last = tick;
+                *count += robots.len();
+            }
+            _ => bursts.push((tick, tick, robots.len())),
+        }
+    }
+    let early: Vec<_> = bursts.iter().filter(|b| b.0 < 300).collect();
+    assert!(
+        early.iter().all(|b| b.2 < 16),
+        "the counters start spread out, so no early burst holds every robot: {early:?}"
+    );
+    let late: Vec<_> = bursts.iter().filter(|b| b.0 >= 2500).collect();
+    assert!(late.len() >= 4, "{late:?}");
+    for (first, last, count) in late {
+        assert_eq!(
+            *count, 16,
+            "late on, every burst holds one flash of each robot: ticks {first}-{last}"
+        );
+        assert!(
+            last - first <= 5,
+            "a burst spans at most half a second: ticks {first}-{last}"
+        );
+    }
+}

@@ -96,6 +96,7 @@ pub fn apply(
     let (v, w) = unicycle(robot.wheels, robot.body.inter_wheel_distance);
     arena.physics.drive(robot.handles.body, v, w);
     robot.led = cmd.led;
+    robot.beacon = cmd.beacon;
     if let Some(opts) = robot.devices.rab
         && cmd.rab_len > 0
     {

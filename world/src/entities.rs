@@ -66,6 +66,8 @@ pub struct Robot {
     pub heading: f32,
     /// LED colour (off when dead).
     pub led: Rgb,
+    /// Beacon LED colour, for a body with a beacon (off when dead).
+    pub beacon: Rgb,
     /// Whether the robot is alive; a dead robot is an inert obstacle (or removed).
     pub alive: bool,
     /// Whether its dead body has left the arena (`<faults dead_bodies="removed">`): it collides with nothing

@@ -110,6 +110,7 @@ impl WorldBuilder {
             position,
             heading,
             led: swarm_contract::messages::Rgb::OFF,
+            beacon: swarm_contract::messages::Rgb::OFF,
             alive: true,
             removed: false,
             wheels: [0.0; 2],
@@ -315,6 +316,7 @@ impl World {
         r.alive = alive;
         if !alive {
             r.led = swarm_contract::messages::Rgb::OFF;
+            r.beacon = swarm_contract::messages::Rgb::OFF;
             r.wheels = [0.0; 2];
             self.arena.physics.drive(r.handles.body, 0.0, 0.0);
         }

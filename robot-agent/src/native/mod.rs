@@ -4,6 +4,8 @@
 pub mod disc_wander;
 pub mod epuck_obstacleavoidance;
 pub mod footbot_diffusion;
+pub mod footbot_flocking;
+pub mod footbot_synchronization;
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
@@ -12,6 +14,8 @@ use crate::params::{ParamError, Params};
 use disc_wander::DiscWander;
 use epuck_obstacleavoidance::EpuckObstacleAvoidance;
 use footbot_diffusion::FootbotDiffusion;
+use footbot_flocking::FootbotFlocking;
+use footbot_synchronization::FootbotSynchronization;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
 pub trait NativeController: Send {
@@ -31,6 +35,12 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (FootbotDiffusion::NAME, |p| {
         Ok(Box::new(FootbotDiffusion::from_params(p)?))
+    }),
+    (FootbotFlocking::NAME, |p| {
+        Ok(Box::new(FootbotFlocking::from_params(p)?))
+    }),
+    (FootbotSynchronization::NAME, |p| {
+        Ok(Box::new(FootbotSynchronization::from_params(p)?))
     }),
     (DiscWander::NAME, |p| {
         Ok(Box::new(DiscWander::from_params(p)?))

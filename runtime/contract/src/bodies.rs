@@ -91,6 +91,8 @@ pub struct BodyModel {
     pub max_turn_rate: f32,
     /// Height of the LEDs the cameras of other robots see, in metres.
     pub led_height: f32,
+    /// Height of the beacon LED in metres, for a body that has one (the foot-bot's turret beacon).
+    pub beacon_height: Option<f32>,
     /// Proximity sensor angles in degrees, counter-clockwise from the heading, in reading order.
     pub proximity_angles_deg: &'static [f32],
     /// Distance of a proximity ray's start from the body centre, in metres.
@@ -172,6 +174,7 @@ pub const EPUCK: BodyModel = BodyModel {
     max_wheel_speed_cm_s: 12.8,
     max_turn_rate: 2.0 * 0.128 / 0.053,
     led_height: 0.086,
+    beacon_height: None,
     proximity_angles_deg: &EPUCK_SENSOR_ANGLES_DEG,
     proximity_mount_radius: 0.035,
     proximity_range: 0.05,
@@ -197,6 +200,7 @@ pub const FOOTBOT: BodyModel = BodyModel {
     max_wheel_speed_cm_s: 30.0,
     max_turn_rate: 2.0 * 0.3 / 0.14,
     led_height: 0.085,
+    beacon_height: Some(0.174_249_73),
     proximity_angles_deg: &FOOTBOT_SENSOR_ANGLES_DEG,
     proximity_mount_radius: 0.085_036_76,
     proximity_range: 0.1,
@@ -229,6 +233,7 @@ pub const DISC: BodyModel = BodyModel {
     max_wheel_speed_cm_s: 22.0,
     max_turn_rate: 2.84,
     led_height: 0.192,
+    beacon_height: None,
     proximity_angles_deg: &[],
     proximity_mount_radius: 0.105,
     proximity_range: 0.0,

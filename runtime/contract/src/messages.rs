@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 3;
+pub const MESSAGE_VERSION: u32 = 4;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -298,8 +298,10 @@ pub struct ActuatorCommand {
     pub wheels: [f32; 2],
     /// Forward speed in m/s and turn rate in rad/s, counter-clockwise positive (used when `drive` is `Twist`).
     pub twist: [f32; 2],
-    /// LED colour.
+    /// LED colour (the e-puck's LEDs; the foot-bot's ring of 12, which ARGoS' `SetAllColors` also sets).
     pub led: Rgb,
+    /// The foot-bot's beacon LED on its turret (ARGoS' LED 12); ignored by bodies without one.
+    pub beacon: Rgb,
     /// Number of range-and-bearing payload bytes to broadcast this tick (0 = send nothing).
     pub rab_len: u8,
     /// Range-and-bearing payload.
@@ -332,6 +334,7 @@ impl ActuatorCommand {
             wheels: [0.0; 2],
             twist: [0.0; 2],
             led: Rgb::OFF,
+            beacon: Rgb::OFF,
             rab_len: 0,
             rab_payload: [0; RAB_PAYLOAD_BYTES],
             gripper: GripperAction::Hold,

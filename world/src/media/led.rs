@@ -1,5 +1,6 @@
 //! The LED medium: every lit LED in the arena (robots, targets lying in the arena, lights) with a grid over their
-//! positions for the cameras' range queries.
+//! positions for the cameras' range queries. A robot's LEDs are one source at its centre (a foot-bot's ring of 12
+//! counts as one blob), plus its beacon if its body has one.
 
 use swarm_contract::messages::Rgb;
 
@@ -43,17 +44,24 @@ impl LedMedium {
     /// Refills the medium: alive robots with their LED on, targets in the arena, lights that are on.
     pub fn rebuild(&mut self, robots: &[Robot], targets: &[Target], lights: &[Light]) {
         self.leds.clear();
-        for (i, r) in robots
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| r.alive && r.led.is_on())
-        {
-            self.leds.push(LedSource {
-                position: r.position,
-                height: r.body.led_height,
-                color: r.led,
-                owner: Some(BodyRef::Robot(i as u32)),
-            });
+        for (i, r) in robots.iter().enumerate().filter(|(_, r)| r.alive) {
+            let owner = Some(BodyRef::Robot(i as u32));
+            if r.led.is_on() {
+                self.leds.push(LedSource {
+                    position: r.position,
+                    height: r.body.led_height,
+                    color: r.led,
+                    owner,
+                });
+            }
+            if let Some(height) = r.body.beacon_height.filter(|_| r.beacon.is_on()) {
+                self.leds.push(LedSource {
+                    position: r.position,
+                    height,
+                    color: r.beacon,
+                    owner,
+                });
+            }
         }
         for (i, t) in targets
             .iter()
