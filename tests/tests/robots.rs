@@ -327,3 +327,34 @@ fn footbot_synchronization_converges_to_one_flash_per_period() {
         );
     }
 }
+
+#[test]
+fn footbot_foraging_brings_items_to_the_nest_and_writes_its_output_in_the_run_folder() {
+    let out = temp_dir();
+    run_example_elsewhere("foraging.argos", out.path(), &["--ticks", "3000"]);
+    let text = std::fs::read_to_string(out.path().join("foraging.txt"))
+        .expect("the loop functions' output is in the run folder");
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("# clock\twalking\tresting\tcollected_food\tenergy")
+    );
+    let rows: Vec<Vec<i64>> = lines
+        .map(|l| {
+            l.split('\t')
+                .map(|v| v.parse().expect("a number"))
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 3000, "one row per tick");
+    for row in &rows {
+        assert_eq!(row[1] + row[2], 20, "every robot walks or rests: {row:?}");
+    }
+    let collected = rows.last().expect("rows")[3];
+    assert!(
+        collected >= 5,
+        "only {collected} items reached the nest in 300 s"
+    );
+    let summary = summary(out.path());
+    assert_eq!(summary["metrics"]["collected_food"], collected);
+}

@@ -77,6 +77,9 @@ pub struct Robot {
     pub wheels: [f32; 2],
     /// The target the virtual gripper carries.
     pub carrying: Option<TargetId>,
+    /// Whether the loop functions gave it an item that is no body in the arena (ARGoS' foraging example's
+    /// food); the frame's `gripper_holding` reports it like a carried target.
+    pub holds_item: bool,
     /// Contacts with any body that started since the run began.
     pub collisions: u64,
     /// Range of the robot's range-and-bearing emitter in metres.

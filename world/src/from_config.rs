@@ -163,8 +163,12 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
 }
 
 /// The `<loop_functions>` element flattened for the factories: the element's own attributes by name, and each
-/// child's as `child.attribute`.
-pub fn loop_functions_params(exp: &Experiment, lf: &config::LoopFunctions) -> LoopFunctionsParams {
+/// child's as `child.attribute`; `seed` is the run's.
+pub fn loop_functions_params(
+    exp: &Experiment,
+    lf: &config::LoopFunctions,
+    seed: u64,
+) -> LoopFunctionsParams {
     let mut attributes = std::collections::BTreeMap::new();
     for (k, a) in &lf.params.attributes {
         attributes.insert(k.clone(), a.value.clone());
@@ -179,6 +183,7 @@ pub fn loop_functions_params(exp: &Experiment, lf: &config::LoopFunctions) -> Lo
         location: locate(exp, lf.location),
         attributes,
         children: lf.params.children.iter().map(|c| c.name.clone()).collect(),
+        seed,
     }
 }
 
@@ -297,7 +302,7 @@ pub fn build(
     let params = exp
         .loop_functions
         .as_ref()
-        .map(|lf| loop_functions_params(exp, lf));
+        .map(|lf| loop_functions_params(exp, lf, seed));
     b.loop_functions(registry.create(params.as_ref())?);
     let mut world = b.build();
     world.set_max_ticks(exp.framework.max_ticks());

@@ -27,6 +27,8 @@ pub enum Purpose {
     Camera = 7,
     /// Range-finder distance noise.
     RangeFinder = 8,
+    /// The loop functions' own draws (e.g. where food items appear).
+    LoopFunctions = 9,
 }
 
 /// The stream for `purpose` and `index` (a robot index, or 0 for world-wide purposes) of the run `seed`.

@@ -115,6 +115,7 @@ impl WorldBuilder {
             removed: false,
             wheels: [0.0; 2],
             carrying: None,
+            holds_item: false,
             collisions: 0,
             rab_range: body.rab_range,
             devices,
@@ -295,6 +296,16 @@ impl World {
         self.loop_functions.metrics(&self.arena)
     }
 
+    /// The file name, in the run folder, of the loop functions' own per-tick output, if they keep one.
+    pub fn loop_output_name(&self) -> Option<&str> {
+        self.loop_functions.output_name()
+    }
+
+    /// Moves the loop functions' output produced since the last call to the end of `out`.
+    pub fn drain_loop_output(&mut self, out: &mut Vec<u8>) {
+        self.loop_functions.drain_output(out);
+    }
+
     /// Grey level of the floor at `p` as the ground sensors read it (loop functions first, then floor regions).
     pub fn floor_at(&self, p: Vec2) -> f32 {
         self.loop_functions
@@ -361,7 +372,7 @@ impl World {
             }
             frame.tick = tick;
             frame.robot = me;
-            frame.gripper_holding = u8::from(robot.carrying.is_some());
+            frame.gripper_holding = u8::from(robot.carrying.is_some() || robot.holds_item);
             frame.position = [robot.position.x, robot.position.y];
             frame.heading = robot.heading;
             if !robot.alive {

@@ -13,6 +13,7 @@ use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use crate::params::{ParamError, Params};
 
 use super::NativeController;
+use super::footbot::ring_sum;
 
 /// Default half-width in degrees of the go-straight cone.
 pub const DEFAULT_ALPHA_DEG: f32 = 10.0;
@@ -22,13 +23,11 @@ pub const DEFAULT_DELTA: f32 = 0.5;
 pub const DEFAULT_VELOCITY: f32 = 2.5;
 
 /// The ARGoS example controller.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FootbotDiffusion {
     alpha: f32,
     delta: f32,
     velocity: f32,
-    /// Unit vectors of the sensor directions, (cos, sin) per sensor.
-    directions: [(f32, f32); FOOTBOT_SENSOR_ANGLES_DEG.len()],
 }
 
 impl FootbotDiffusion {
@@ -43,22 +42,14 @@ impl FootbotDiffusion {
                 .to_radians(),
             delta: params.non_negative_f32_or("delta", DEFAULT_DELTA)?,
             velocity: params.non_negative_f32_or("velocity", DEFAULT_VELOCITY)?,
-            directions: FOOTBOT_SENSOR_ANGLES_DEG.map(|a| {
-                let (s, c) = a.to_radians().sin_cos();
-                (c, s)
-            }),
         })
     }
 }
 
 impl NativeController for FootbotDiffusion {
     fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {
-        let (mut x, mut y) = (0.0f32, 0.0f32);
-        for (reading, (c, s)) in frame.proximity_readings().iter().zip(&self.directions) {
-            x += reading * c;
-            y += reading * s;
-        }
-        let n = self.directions.len() as f32;
+        let (x, y) = ring_sum(frame.proximity_readings());
+        let n = FOOTBOT_SENSOR_ANGLES_DEG.len() as f32;
         let (x, y) = (x / n, y / n);
         let angle = y.atan2(x);
         let v = self.velocity;

@@ -9,46 +9,29 @@
 //!   Lennard-Jones term `-gain / d ((t / d)^(2e) - (t / d)^e)` along the blob's bearing (d and t in cm, e the
 //!   `exponent`), averaged over those blobs and capped at `max_speed`.
 //!
-//! The vector becomes wheel speeds through three turning modes with hysteresis: no turn (both wheels at the
-//! vector's length, capped at `max_speed`), soft turn (inner wheel slowed, outer sped up in proportion to the
-//! angle) and hard turn (spin at `max_speed`); a soft turn starts beyond `no_turn_angle_threshold`, a hard one
-//! beyond `hard_turn_angle_threshold`, and a hard turn ends within `soft_turn_angle_threshold`.
+//! The vector becomes wheel speeds through ARGoS' wheel-turning rule ([`WheelTurning`]).
 //!
 //! Parameters as in the example's `<params>`: `<wheel_turning hard_turn_angle_threshold soft_turn_angle_threshold
 //! no_turn_angle_threshold max_speed/>` (degrees, cm/s) and `<flocking target_distance gain exponent/>`; ARGoS
 //! requires them all, here the example's values (90, 70, 10, 10; 75, 1000, 2) are the defaults.
 
-use swarm_contract::bodies::FOOTBOT_SENSOR_ANGLES_DEG;
 use swarm_contract::messages::{ActuatorCommand, Rgb, SensorFrame};
 
 use crate::params::{ParamError, Params};
 
 use super::NativeController;
+use super::footbot::{WheelTurning, ring_sum};
 
 /// Red, the colour flocking robots show on their beacon and look for.
 const RED: Rgb = Rgb { r: 255, g: 0, b: 0 };
 
-/// Which wheel rule applies; kept between ticks (the rule has hysteresis).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Turning {
-    None,
-    Soft,
-    Hard,
-}
-
 /// The ARGoS example controller.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FootbotFlocking {
-    hard_turn: f32,
-    soft_turn: f32,
-    no_turn: f32,
-    max_speed: f32,
+    wheels: WheelTurning,
     target_distance: f32,
     gain: f32,
     exponent: f32,
-    turning: Turning,
-    /// Unit vectors of the light sensor directions, (cos, sin) per sensor.
-    light_directions: [(f32, f32); FOOTBOT_SENSOR_ANGLES_DEG.len()],
 }
 
 impl FootbotFlocking {
@@ -57,24 +40,11 @@ impl FootbotFlocking {
 
     /// Reads the `wheel_turning.*` and `flocking.*` parameters.
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
-        let angle = |name: &str, default: f32| {
-            params
-                .non_negative_f32_or(name, default)
-                .map(f32::to_radians)
-        };
         Ok(Self {
-            hard_turn: angle("wheel_turning.hard_turn_angle_threshold", 90.0)?,
-            soft_turn: angle("wheel_turning.soft_turn_angle_threshold", 70.0)?,
-            no_turn: angle("wheel_turning.no_turn_angle_threshold", 10.0)?,
-            max_speed: params.non_negative_f32_or("wheel_turning.max_speed", 10.0)?,
+            wheels: WheelTurning::from_params(params)?,
             target_distance: params.non_negative_f32_or("flocking.target_distance", 75.0)?,
             gain: params.f32_or("flocking.gain", 1000.0)?,
             exponent: params.f32_or("flocking.exponent", 2.0)?,
-            turning: Turning::None,
-            light_directions: FOOTBOT_SENSOR_ANGLES_DEG.map(|a| {
-                let (s, c) = a.to_radians().sin_cos();
-                (c, s)
-            }),
         })
     }
 
@@ -86,14 +56,10 @@ impl FootbotFlocking {
     }
 
     fn vector_to_light(&self, frame: &SensorFrame) -> (f32, f32) {
-        let (mut x, mut y) = (0.0f32, 0.0f32);
-        for (reading, (c, s)) in frame.light_readings().iter().zip(&self.light_directions) {
-            x += reading * c;
-            y += reading * s;
-        }
+        let (x, y) = ring_sum(frame.light_readings());
         let length = x.hypot(y);
         if length > 0.0 {
-            let scale = 0.25 * self.max_speed / length;
+            let scale = 0.25 * self.wheels.max_speed / length;
             (x * scale, y * scale)
         } else {
             (0.0, 0.0)
@@ -116,41 +82,11 @@ impl FootbotFlocking {
         }
         let (x, y) = (x / seen as f32, y / seen as f32);
         let length = x.hypot(y);
-        if length > self.max_speed {
-            (x * self.max_speed / length, y * self.max_speed / length)
+        let max = self.wheels.max_speed;
+        if length > max {
+            (x * max / length, y * max / length)
         } else {
             (x, y)
-        }
-    }
-
-    /// Wheel speeds (left, right) in cm/s that steer along `(x, y)`, updating the turning mode.
-    fn wheels_towards(&mut self, (x, y): (f32, f32)) -> [f32; 2] {
-        let angle = y.atan2(x);
-        let off = angle.abs();
-        let base = x.hypot(y).min(self.max_speed);
-        self.turning = match self.turning {
-            Turning::Hard if off <= self.soft_turn => Turning::Soft,
-            other => other,
-        };
-        self.turning = match self.turning {
-            Turning::Soft if off > self.hard_turn => Turning::Hard,
-            Turning::Soft if off <= self.no_turn => Turning::None,
-            Turning::None if off > self.hard_turn => Turning::Hard,
-            Turning::None if off > self.no_turn => Turning::Soft,
-            other => other,
-        };
-        let (inner, outer) = match self.turning {
-            Turning::None => (base, base),
-            Turning::Soft => {
-                let factor = (self.hard_turn - off) / self.hard_turn;
-                (base * factor, base * (2.0 - factor))
-            }
-            Turning::Hard => (-self.max_speed, self.max_speed),
-        };
-        if angle > 0.0 {
-            [inner, outer]
-        } else {
-            [outer, inner]
         }
     }
 }
@@ -159,7 +95,9 @@ impl NativeController for FootbotFlocking {
     fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {
         let light = self.vector_to_light(frame);
         let flock = self.flocking_vector(frame);
-        command.wheels = self.wheels_towards((light.0 + flock.0, light.1 + flock.1));
+        command.wheels = self
+            .wheels
+            .wheels_towards((light.0 + flock.0, light.1 + flock.1));
         command.beacon = RED;
     }
 }

@@ -3,8 +3,10 @@
 
 pub mod disc_wander;
 pub mod epuck_obstacleavoidance;
+pub mod footbot;
 pub mod footbot_diffusion;
 pub mod footbot_flocking;
+pub mod footbot_foraging;
 pub mod footbot_synchronization;
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
@@ -15,6 +17,7 @@ use disc_wander::DiscWander;
 use epuck_obstacleavoidance::EpuckObstacleAvoidance;
 use footbot_diffusion::FootbotDiffusion;
 use footbot_flocking::FootbotFlocking;
+use footbot_foraging::FootbotForaging;
 use footbot_synchronization::FootbotSynchronization;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
@@ -38,6 +41,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (FootbotFlocking::NAME, |p| {
         Ok(Box::new(FootbotFlocking::from_params(p)?))
+    }),
+    (FootbotForaging::NAME, |p| {
+        Ok(Box::new(FootbotForaging::from_params(p)?))
     }),
     (FootbotSynchronization::NAME, |p| {
         Ok(Box::new(FootbotSynchronization::from_params(p)?))

@@ -136,7 +136,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         &limits,
     )?;
     let mut recorder = Recorder::create(&args.out, &world, &[0])?;
-    recorder.record(&world)?;
+    recorder.record(&mut world)?;
     report(WorldReport::Ready {
         robots: robots as u32,
     });
@@ -180,7 +180,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             }
         }
         world.act_and_step(&commands, &has_command);
-        recorder.record(&world)?;
+        recorder.record(&mut world)?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);
         commands_missing += u64::from(outcome.missing);

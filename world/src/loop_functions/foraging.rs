@@ -26,6 +26,7 @@ use crate::arena::{Arena, GripperEvent};
 use crate::entities::{TargetId, TargetState};
 use crate::error::WorldError;
 use crate::geometry::Vec2;
+use crate::loop_functions::argos_foraging::ArgosForaging;
 use crate::loop_functions::{LoopFunctions, LoopFunctionsParams};
 
 /// The label under which the configuration selects these loop functions.
@@ -182,8 +183,11 @@ impl Foraging {
         }
     }
 
-    /// The factory registered under [`LABEL`].
+    /// The factory registered under [`LABEL`]. `<foraging items=...>` selects ARGoS' foot-bot foraging example instead ([`ArgosForaging`]).
     pub fn factory(params: &LoopFunctionsParams) -> Result<Box<dyn LoopFunctions>, WorldError> {
+        if ArgosForaging::applies_to(params) {
+            return ArgosForaging::factory(params);
+        }
         Ok(Box::new(Self::new(ForagingParams::parse(params, &[])?)))
     }
 

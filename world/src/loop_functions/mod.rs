@@ -3,6 +3,7 @@
 //! `<loop_functions label="...">` uses. Tasks add their own by registering a factory; the core never changes.
 
 pub mod aggregation;
+pub mod argos_foraging;
 pub mod default;
 pub mod foraging;
 pub mod obstacle_avoidance;
@@ -46,6 +47,15 @@ pub trait LoopFunctions: Send {
 
     /// The task metrics so far, for `summary.json`.
     fn metrics(&self, arena: &Arena) -> serde_json::Value;
+
+    /// The file name, in the run folder, of the loop functions' own per-tick output (ARGoS loop functions'
+    /// output files), if they keep one.
+    fn output_name(&self) -> Option<&str> {
+        None
+    }
+
+    /// Moves the output text produced since the last call to the end of `out`.
+    fn drain_output(&mut self, _out: &mut Vec<u8>) {}
 }
 
 /// The `<loop_functions>` element as the factories see it.
@@ -60,6 +70,8 @@ pub struct LoopFunctionsParams {
     pub attributes: BTreeMap<String, String>,
     /// The names of the element's children, in file order (a child without attributes is only here).
     pub children: Vec<String>,
+    /// The run's seed, for loop functions that draw random numbers (from their own stream).
+    pub seed: u64,
 }
 
 impl LoopFunctionsParams {

@@ -31,6 +31,32 @@ pub struct Recorder {
     dir: PathBuf,
     files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
+    loop_output: Option<LoopOutput>,
+}
+
+/// The loop functions' own output file, written on the tick thread: a short line per tick at most, and only for
+/// loop functions that keep one (ARGoS' foraging example), never on the thesis tasks' path.
+struct LoopOutput {
+    path: PathBuf,
+    file: std::io::BufWriter<std::fs::File>,
+    buffer: Vec<u8>,
+}
+
+impl LoopOutput {
+    fn write(&mut self, world: &mut World) -> Result<(), WorldError> {
+        use std::io::Write;
+        world.drain_loop_output(&mut self.buffer);
+        let io = |source| WorldError::Io {
+            path: self.path.clone(),
+            source,
+        };
+        self.file.write_all(&self.buffer).map_err(io)?;
+        self.buffer.clear();
+        self.file.flush().map_err(|source| WorldError::Io {
+            path: self.path.clone(),
+            source,
+        })
+    }
 }
 
 impl Recorder {
@@ -47,10 +73,26 @@ impl Recorder {
             events: EventsWriter::create(dir, &world.arena)?,
             trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
         };
+        let loop_output = match world.loop_output_name() {
+            None => None,
+            Some(name) => {
+                let path = dir.join(name);
+                let file = std::fs::File::create(&path).map_err(|source| WorldError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                Some(LoopOutput {
+                    path,
+                    file: std::io::BufWriter::new(file),
+                    buffer: Vec::new(),
+                })
+            }
+        };
         Ok(Self {
             dir: dir.to_path_buf(),
             files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
+            loop_output,
         })
     }
 
@@ -76,7 +118,10 @@ impl Recorder {
 
     /// Ends the world's current tick: its trajectory rows and the events recorded since the last tick go to
     /// the writing thread, and a snapshot is drawn if this tick is scheduled.
-    pub fn record(&mut self, world: &World) -> Result<(), WorldError> {
+    pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
+        if let Some(output) = &mut self.loop_output {
+            output.write(world)?;
+        }
         PoseRow::capture(&world.arena, |row| self.files.push(RecordRow::Pose(row)));
         self.files.end_batch()?;
         if self.snapshot_ticks.contains(&world.tick()) {

@@ -18,10 +18,10 @@ fn recorded_run(seed: u64, ticks: u64, dir: &std::path::Path) -> Vec<u8> {
     exp.controllers[0].actuators[0].noise_std_dev = 0.05;
     let mut world = World::new(&exp, seed).expect("builds");
     let mut recorder = Recorder::create(dir, &world, &[]).expect("recorder");
-    recorder.record(&world).expect("record");
+    recorder.record(&mut world).expect("record");
     for _ in 0..ticks {
         world.run_in_process(1, avoid_obstacles);
-        recorder.record(&world).expect("record");
+        recorder.record(&mut world).expect("record");
     }
     recorder.sync().expect("written");
     std::fs::read(dir.join("trajectory.csv")).expect("trajectory written")
@@ -65,10 +65,10 @@ fn recorder_writes_summary_metrics_and_png_snapshots_of_the_start_and_the_final_
     });
     let mut world = World::new(&exp, 7).expect("builds");
     let mut recorder = Recorder::create(dir.path(), &world, &[0]).expect("recorder");
-    recorder.record(&world).expect("record");
+    recorder.record(&mut world).expect("record");
     for _ in 0..20 {
         world.run_in_process(1, avoid_obstacles);
-        recorder.record(&world).expect("record");
+        recorder.record(&mut world).expect("record");
     }
     let summary = recorder
         .finish(&world, serde_json::json!({ "seed": 7 }))

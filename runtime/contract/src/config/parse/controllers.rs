@@ -2,7 +2,7 @@
 
 use super::{Ctx, MediumRef};
 use crate::config::model::{Controller, Device, DeviceRole, Element, Location, LoopFunctions};
-use crate::config::registry::{self, Entry};
+use crate::config::registry::{self, Entry, MediumKind};
 use crate::config::suggest::did_you_mean;
 
 const CONTROLLER_CHILDREN: &[&str] = &["actuators", "sensors", "params"];
@@ -225,6 +225,8 @@ fn device(ctx: &mut Ctx, el: &Element, entry: &Entry, controller: &str) -> Optio
                 .map_or(el.location, |a| a.location),
             user: user.clone(),
         }),
+        // ARGoS' range-and-bearing actuator names no medium: it emits into the one the sensor listens to.
+        (Some(MediumKind::RangeAndBearing), None) if entry.role == DeviceRole::Actuator => {}
         (Some(kind), None) => ctx.error(
             el.location,
             format!("{user} needs a 'medium' naming a <{}> medium", kind.tag()),
