@@ -115,6 +115,12 @@ const BUILTINS: &[Builtin] = &[
         },
     },
     Builtin {
+        element: "footbot_gripping_controller",
+        plan: || Plan::Native {
+            name: native::footbot_gripping::FootbotGripping::NAME.to_owned(),
+        },
+    },
+    Builtin {
         element: "footbot_synchronization_controller",
         plan: || Plan::Native {
             name: native::footbot_synchronization::FootbotSynchronization::NAME.to_owned(),
@@ -376,8 +382,9 @@ mod tests {
             "unknown controller `footbot_nn_controller`: give `profile` and `supervisors` in <params>, or use one \
              of: epuck_obstacle_avoidance_sct_prob_controller, epuck_obstacleavoidance_controller, \
              footbot_diffusion_controller, footbot_flocking_controller, footbot_foraging_controller, \
-             footbot_synchronization_controller, epuck_obstacleavoidance, footbot_diffusion, footbot_flocking, \
-             footbot_foraging, footbot_synchronization, disc_wander"
+             footbot_gripping_controller, footbot_synchronization_controller, epuck_obstacleavoidance, \
+             footbot_diffusion, footbot_flocking, footbot_foraging, footbot_gripping, footbot_synchronization, \
+             disc_wander"
         );
     }
 }

@@ -61,7 +61,14 @@ fn positions(out: &Path) -> BTreeMap<u32, Vec<(u64, f64, f64)>> {
 
 #[test]
 fn argos_footbot_examples_run_unchanged_from_any_folder() {
-    for (example, robots) in [("diffusion_1.argos", 1), ("diffusion_10.argos", 10)] {
+    for (example, robots) in [
+        ("diffusion_1.argos", 1),
+        ("diffusion_10.argos", 10),
+        ("flocking.argos", 10),
+        ("synchronization.argos", 16),
+        ("foraging.argos", 20),
+        ("gripping.argos", 1),
+    ] {
         let out = temp_dir();
         run_example_elsewhere(example, out.path(), &["--ticks", "20"]);
         let summary = summary(out.path());
@@ -357,4 +364,83 @@ fn footbot_foraging_brings_items_to_the_nest_and_writes_its_output_in_the_run_fo
     );
     let summary = summary(out.path());
     assert_eq!(summary["metrics"]["collected_food"], collected);
+}
+
+/// The `gripper:*` and `fault:*` rows of `events.csv` as (tick, robot, event).
+fn gripper_and_fault_events(out: &Path) -> Vec<(u64, u32, String)> {
+    let text = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    text.lines()
+        .skip(1)
+        .filter_map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            let event = f.last()?;
+            (event.starts_with("gripper:") || event.starts_with("fault:")).then(|| {
+                (
+                    f[0].parse().expect("tick"),
+                    f[1].parse().expect("robot"),
+                    (*event).to_owned(),
+                )
+            })
+        })
+        .collect()
+}
+
+/// The final x of the movable object `id`, from `summary.json`.
+fn final_x(out: &Path, id: &str) -> f64 {
+    summary(out)["movable_objects"]
+        .as_array()
+        .expect("movable_objects")
+        .iter()
+        .find(|o| o["id"] == id)
+        .and_then(|o| o["x"].as_f64())
+        .expect("the object is listed")
+}
+
+#[test]
+fn footbot_gripping_grips_pulls_and_lets_go() {
+    let out = temp_dir();
+    run_example_elsewhere("gripping.argos", out.path(), &[]);
+    assert_eq!(
+        gripper_and_fault_events(out.path()),
+        [
+            (70, 0, "gripper:grip".to_owned()),
+            (120, 0, "gripper:release".to_owned())
+        ]
+    );
+    // The cylinder started 0.5 m out; the robot pulled it back for 4.9 s at 5 cm/s.
+    let x = final_x(out.path(), "c");
+    assert!(x < 0.35, "the cylinder was pulled back to x = {x:.3}");
+}
+
+#[test]
+fn two_footbots_pull_one_box_and_one_dying_lets_go() {
+    let out = temp_dir();
+    run_config(
+        &workspace_file("configs/robots/two_footbots_pull_a_box.argos"),
+        out.path(),
+        &[],
+    );
+    let grips: Vec<_> = gripper_and_fault_events(out.path())
+        .into_iter()
+        .filter(|e| e.2 == "gripper:grip")
+        .collect();
+    assert_eq!(grips.len(), 2, "both robots grip the box: {grips:?}");
+    let x = final_x(out.path(), "crate");
+    assert!(x < 0.4, "the box was pulled from x = 0.57 to {x:.3}");
+
+    let out = temp_dir();
+    run_config(
+        &workspace_file("configs/robots/two_footbots_pull_a_box.argos"),
+        out.path(),
+        &["--fault", "kill robots=0 tick=90"],
+    );
+    let events = gripper_and_fault_events(out.path());
+    assert!(
+        events.contains(&(90, 0, "gripper:release_on_death".to_owned())),
+        "{events:?}"
+    );
+    assert!(
+        events.contains(&(120, 1, "gripper:release".to_owned())),
+        "the survivor holds on until its own script lets go: {events:?}"
+    );
 }

@@ -10,6 +10,7 @@ use swarm_contract::messages::{ActuatorCommand, Drive, GripperAction, PHEROMONE_
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{RobotId, TargetId, TargetState};
 use crate::geometry::unit;
+use crate::gripper::GripperState;
 use crate::media::rab::RabMedium;
 
 /// Default largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm);
@@ -112,6 +113,24 @@ pub fn apply(
         arena
             .pheromone
             .deposit(ch, position, cmd.pheromone_deposit[ch]);
+    }
+    if robot.devices.gripper.is_some() {
+        let gripper = &mut robot.gripper;
+        match cmd.gripper {
+            GripperAction::Hold => {}
+            GripperAction::Pick => gripper.locked = true,
+            GripperAction::Drop => {
+                *gripper = GripperState {
+                    locked: false,
+                    lost: false,
+                    ..*gripper
+                }
+            }
+        }
+        if gripper.holding.is_none() && cmd.turret.is_finite() {
+            gripper.turret = crate::geometry::wrap_angle(cmd.turret);
+        }
+        return;
     }
     match cmd.gripper {
         GripperAction::Hold => {}

@@ -3,13 +3,35 @@
 //! changes; the order of a tick lives in `world`.
 
 use crate::entities::{
-    FloorRegion, Light, Obstacle, Robot, RobotId, Target, TargetId, TargetState,
+    FloorRegion, Light, Obstacle, ObstacleId, Robot, RobotId, Target, TargetId, TargetState,
 };
 use crate::geometry::Vec2;
 use crate::media::pheromone::PheromoneField;
 use crate::physics::Physics;
 
-/// What the virtual grippers did in the last tick.
+/// Why a physical gripper let go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReleaseCause {
+    /// Its controller unlocked it.
+    Opened,
+    /// Holding on took more than the gripper's `max_force` (`gripper::load`).
+    Overloaded,
+    /// The robot died.
+    Died,
+}
+
+impl ReleaseCause {
+    /// The name `events.csv` gives a release for this cause.
+    pub fn event_name(self) -> &'static str {
+        match self {
+            ReleaseCause::Opened => "gripper:release",
+            ReleaseCause::Overloaded => "gripper:lost",
+            ReleaseCause::Died => "gripper:release_on_death",
+        }
+    }
+}
+
+/// What the grippers (virtual and physical) did in the last tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum GripperEvent {
     /// A robot picked a target up.
@@ -27,6 +49,22 @@ pub enum GripperEvent {
         target: TargetId,
         /// Where the target now lies.
         position: Vec2,
+    },
+    /// A robot's physical gripper gripped a movable obstacle.
+    Gripped {
+        /// The robot.
+        robot: RobotId,
+        /// The object.
+        obstacle: ObstacleId,
+    },
+    /// A robot's physical gripper let go of a movable obstacle.
+    Released {
+        /// The robot.
+        robot: RobotId,
+        /// The object.
+        obstacle: ObstacleId,
+        /// Why.
+        cause: ReleaseCause,
     },
 }
 

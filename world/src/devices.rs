@@ -43,6 +43,13 @@ pub struct RangeFinderOptions {
     pub noise_std_dev: f32,
 }
 
+/// Options of the physical gripper (`footbot_gripper`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GripperOptions {
+    /// Largest force in newtons a grip holds before it is lost.
+    pub max_force: f32,
+}
+
 /// The devices of one robot.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Devices {
@@ -56,6 +63,8 @@ pub struct Devices {
     pub camera: Option<CameraOptions>,
     /// Range-finder ring.
     pub range_finder: Option<RangeFinderOptions>,
+    /// Physical gripper.
+    pub gripper: Option<GripperOptions>,
     /// Range-and-bearing sensor and actuator.
     pub rab: Option<RabOptions>,
     /// Multiplicative Gaussian wheel noise `noise_std_dev` (0 = none).
@@ -76,6 +85,7 @@ impl Devices {
         ground: Some(0.0),
         camera: Some(CameraOptions { noise_std_dev: 0.0 }),
         range_finder: None,
+        gripper: None,
         rab: Some(RabOptions {
             data_size: 2,
             loss_probability: 0.0,
@@ -95,6 +105,7 @@ impl Devices {
         ground: None,
         camera: None,
         range_finder: None,
+        gripper: None,
         rab: None,
         wheel_noise_std_dev: 0.0,
         gripper_reach: GRIPPER_REACH,

@@ -9,6 +9,7 @@ use swarm_contract::messages::Rgb;
 
 use crate::devices::Devices;
 use crate::geometry::{Placed, Shape, Vec2};
+use crate::gripper::GripperState;
 use crate::physics::{BodyHandles, Motion};
 use crate::rng::RobotStreams;
 
@@ -77,6 +78,8 @@ pub struct Robot {
     pub wheels: [f32; 2],
     /// The target the virtual gripper carries.
     pub carrying: Option<TargetId>,
+    /// The physical gripper and turret (used when the controller declares `footbot_gripper`).
+    pub gripper: GripperState,
     /// Whether the loop functions gave it an item that is no body in the arena (ARGoS' foraging example's
     /// food); the frame's `gripper_holding` reports it like a carried target.
     pub holds_item: bool,

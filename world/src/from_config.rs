@@ -12,11 +12,14 @@ use swarm_contract::config::{
 use swarm_contract::messages::{MAX_RANGE_RAYS, PHEROMONE_CHANNELS, Rgb};
 
 use crate::actuators::GRIPPER_REACH;
-use crate::devices::{CameraOptions, Devices, ProximityOptions, RabOptions, RangeFinderOptions};
+use crate::devices::{
+    CameraOptions, Devices, GripperOptions, ProximityOptions, RabOptions, RangeFinderOptions,
+};
 use crate::distribute::{self, outline};
 use crate::entities::{FloorRegion, Light};
 use crate::error::WorldError;
 use crate::geometry::{Placed, Vec2};
+use crate::gripper::DEFAULT_MAX_FORCE;
 use crate::loop_functions::{LoopFunctionsParams, LoopFunctionsRegistry};
 use crate::media::pheromone::ChannelRates;
 use crate::physics::Motion;
@@ -136,6 +139,36 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
             })
         }
     };
+    let gripper = match c.actuator(DeviceKind::Gripper) {
+        None => None,
+        Some(d) => {
+            if let Some(virtual_gripper) = c.actuator(DeviceKind::VirtualGripper) {
+                return Err(invalid(
+                    exp,
+                    virtual_gripper.location,
+                    format!(
+                        "controller '{}' declares both 'virtual_gripper' and 'footbot_gripper' (at {}); a robot has one gripper",
+                        c.id, d.location
+                    ),
+                ));
+            }
+            let max_force = d
+                .attributes
+                .parse::<f64>("max_force")
+                .map_err(|e| invalid(exp, e.location, e.message))?
+                .unwrap_or(f64::from(DEFAULT_MAX_FORCE));
+            if !(max_force > 0.0 && max_force.is_finite()) {
+                return Err(invalid(
+                    exp,
+                    d.location,
+                    format!("max_force {max_force} must be a force above 0 N"),
+                ));
+            }
+            Some(GripperOptions {
+                max_force: max_force as f32,
+            })
+        }
+    };
     let gripper_reach = match c.actuator(DeviceKind::VirtualGripper) {
         None => GRIPPER_REACH,
         Some(d) => d
@@ -154,6 +187,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
                 noise_std_dev: d.noise_std_dev as f32,
             }),
         range_finder,
+        gripper,
         rab,
         wheel_noise_std_dev: c
             .actuator(DeviceKind::Wheels)

@@ -14,6 +14,7 @@ pub mod entities;
 pub mod error;
 pub mod from_config;
 pub mod geometry;
+pub mod gripper;
 pub mod in_process;
 pub mod loop_functions;
 pub mod media;

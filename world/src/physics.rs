@@ -9,8 +9,8 @@ use std::sync::Mutex;
 
 use rapier2d::prelude::{
     ActiveEvents, ColliderBuilder, ColliderHandle, ColliderSet, CollisionEvent, ContactPair,
-    EventHandler, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet,
-    SoftBodyTearEvent,
+    EventHandler, ImpulseJointHandle, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
+    RigidBodyHandle, RigidBodySet, SoftBodySet, SoftBodyTearEvent,
 };
 
 use crate::geometry::{Shape, Vec2};
@@ -183,6 +183,42 @@ impl Physics {
             b.set_linvel(Vec2::ZERO, true);
             b.set_angvel(0.0, true);
         }
+    }
+
+    /// Pins `body1` and `body2` together at the arena point `at` with a revolute joint (the bodies may turn about
+    /// it, as a gripper's pivot lets them); the pinned bodies no longer collide with each other.
+    pub fn pin(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        at: Vec2,
+    ) -> Option<ImpulseJointHandle> {
+        let local = |h: RigidBodyHandle| {
+            self.world
+                .bodies
+                .get(h)
+                .map(|b| b.position().inverse_transform_point(at))
+        };
+        let (anchor1, anchor2) = (local(body1)?, local(body2)?);
+        let joint = RevoluteJointBuilder::new()
+            .local_anchor1(anchor1)
+            .local_anchor2(anchor2)
+            .contacts_enabled(false)
+            .build();
+        Some(self.world.impulse_joints.insert(body1, body2, joint, true))
+    }
+
+    /// Removes a joint made by [`Physics::pin`].
+    pub fn unpin(&mut self, joint: ImpulseJointHandle) {
+        self.world.impulse_joints.remove(joint, true);
+    }
+
+    /// A body's linear velocity in m/s after the last step.
+    pub fn velocity(&self, body: RigidBodyHandle) -> Vec2 {
+        self.world
+            .bodies
+            .get(body)
+            .map_or(Vec2::ZERO, |b| b.linvel())
     }
 
     /// Current position and heading of a body.

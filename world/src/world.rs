@@ -12,7 +12,7 @@ use swarm_contract::config::faults::DeadBodies;
 use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use crate::actuators;
-use crate::arena::Arena;
+use crate::arena::{Arena, GripperEvent, ReleaseCause};
 use crate::devices::Devices;
 use crate::entities::{
     FloorRegion, Light, LightId, Obstacle, ObstacleId, Robot, RobotId, Target, TargetId,
@@ -20,6 +20,7 @@ use crate::entities::{
 };
 use crate::error::WorldError;
 use crate::geometry::{Placed, Vec2};
+use crate::gripper::GripperState;
 use crate::loop_functions::{LoopFunctions, LoopFunctionsRegistry, default::DefaultLoopFunctions};
 use crate::media::led::LedMedium;
 use crate::media::pheromone::{ChannelRates, PheromoneField};
@@ -115,6 +116,7 @@ impl WorldBuilder {
             removed: false,
             wheels: [0.0; 2],
             carrying: None,
+            gripper: GripperState::default(),
             holds_item: false,
             collisions: 0,
             rab_range: body.rab_range,
@@ -231,6 +233,7 @@ impl WorldBuilder {
             scratch: Vec::with_capacity(64),
             max_ticks: None,
             dead_bodies: DeadBodies::Inert,
+            pending_gripper_events: Vec::new(),
         };
         world.update_media();
         world
@@ -248,6 +251,8 @@ pub struct World {
     scratch: Vec<u32>,
     max_ticks: Option<u64>,
     dead_bodies: DeadBodies,
+    /// Gripper events that happened between ticks (a robot killed by a fault), reported with the next tick's.
+    pending_gripper_events: Vec<GripperEvent>,
 }
 
 impl World {
@@ -321,6 +326,13 @@ impl World {
     /// Marks a robot alive or dead. A dead robot never acts and its LED is off; its body stays as an inert
     /// obstacle or, with [`DeadBodies::Removed`], leaves the arena until the robot is alive again.
     pub fn set_alive(&mut self, robot: RobotId, alive: bool) {
+        if !alive {
+            // A dead robot's gripper opens; the event belongs to the coming tick's record.
+            let before = self.arena.gripper_events.len();
+            crate::gripper::release(&mut self.arena, robot, ReleaseCause::Died);
+            self.pending_gripper_events
+                .extend(self.arena.gripper_events.drain(before..));
+        }
         let Some(r) = self.arena.robots.get_mut(robot.index()) else {
             return;
         };
@@ -372,7 +384,9 @@ impl World {
             }
             frame.tick = tick;
             frame.robot = me;
-            frame.gripper_holding = u8::from(robot.carrying.is_some() || robot.holds_item);
+            frame.gripper_holding = u8::from(
+                robot.carrying.is_some() || robot.holds_item || robot.gripper.holding.is_some(),
+            );
             frame.position = [robot.position.x, robot.position.y];
             frame.heading = robot.heading;
             if !robot.alive {
@@ -471,6 +485,9 @@ impl World {
     pub fn act_and_step(&mut self, commands: &[ActuatorCommand], has_command: &[bool]) {
         self.arena.tick += 1;
         self.arena.gripper_events.clear();
+        self.arena
+            .gripper_events
+            .append(&mut self.pending_gripper_events);
         self.loop_functions.pre_step(&mut self.arena);
         self.rab.clear();
         for i in 0..self.arena.robots.len() {
@@ -499,6 +516,7 @@ impl World {
         for r in &mut arena.robots {
             (r.position, r.heading) = arena.physics.pose(r.handles.body);
         }
+        crate::gripper::update(arena);
         for o in arena
             .obstacles
             .iter_mut()

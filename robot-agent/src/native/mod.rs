@@ -7,6 +7,7 @@ pub mod footbot;
 pub mod footbot_diffusion;
 pub mod footbot_flocking;
 pub mod footbot_foraging;
+pub mod footbot_gripping;
 pub mod footbot_synchronization;
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
@@ -18,6 +19,7 @@ use epuck_obstacleavoidance::EpuckObstacleAvoidance;
 use footbot_diffusion::FootbotDiffusion;
 use footbot_flocking::FootbotFlocking;
 use footbot_foraging::FootbotForaging;
+use footbot_gripping::FootbotGripping;
 use footbot_synchronization::FootbotSynchronization;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
@@ -44,6 +46,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (FootbotForaging::NAME, |p| {
         Ok(Box::new(FootbotForaging::from_params(p)?))
+    }),
+    (FootbotGripping::NAME, |p| {
+        Ok(Box::new(FootbotGripping::from_params(p)?))
     }),
     (FootbotSynchronization::NAME, |p| {
         Ok(Box::new(FootbotSynchronization::from_params(p)?))

@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 4;
+pub const MESSAGE_VERSION: u32 = 5;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -306,8 +306,11 @@ pub struct ActuatorCommand {
     pub rab_len: u8,
     /// Range-and-bearing payload.
     pub rab_payload: [u8; RAB_PAYLOAD_BYTES],
-    /// Gripper action.
+    /// Gripper action: for the virtual gripper, pick or drop a target; for the foot-bot's physical gripper,
+    /// `Pick` locks it (it grips what comes within reach) and `Drop` unlocks it.
     pub gripper: GripperAction,
+    /// The foot-bot turret's angle in radians, counter-clockwise from the heading: where the gripper faces.
+    pub turret: f32,
     /// Amount of pheromone to deposit at the robot's position, per channel.
     pub pheromone_deposit: [f32; PHEROMONE_CHANNELS],
     /// Number of valid entries in `events`.
@@ -338,6 +341,7 @@ impl ActuatorCommand {
             rab_len: 0,
             rab_payload: [0; RAB_PAYLOAD_BYTES],
             gripper: GripperAction::Hold,
+            turret: 0.0,
             pheromone_deposit: [0.0; PHEROMONE_CHANNELS],
             events_len: 0,
             events: [0; MAX_EVENTS_PER_TICK],

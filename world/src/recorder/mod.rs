@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 
 use swarm_contract::messages::ActuatorCommand;
 
+use crate::arena::GripperEvent;
 use crate::error::WorldError;
 use crate::world::World;
 
@@ -116,11 +117,21 @@ impl Recorder {
         }));
     }
 
-    /// Ends the world's current tick: its trajectory rows and the events recorded since the last tick go to
-    /// the writing thread, and a snapshot is drawn if this tick is scheduled.
+    /// Ends the world's current tick: the physical grippers' events of the tick (`gripper:grip`,
+    /// `gripper:release`, `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded
+    /// since the last tick go to the writing thread, and a snapshot is drawn if this tick is scheduled.
     pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
         if let Some(output) = &mut self.loop_output {
             output.write(world)?;
+        }
+        let tick = world.tick();
+        for event in &world.arena.gripper_events {
+            let (robot, name) = match *event {
+                GripperEvent::Gripped { robot, .. } => (robot, "gripper:grip"),
+                GripperEvent::Released { robot, cause, .. } => (robot, cause.event_name()),
+                GripperEvent::Picked { .. } | GripperEvent::Dropped { .. } => continue,
+            };
+            self.record_fault(tick, robot.index(), name);
         }
         PoseRow::capture(&world.arena, |row| self.files.push(RecordRow::Pose(row)));
         self.files.end_batch()?;
@@ -144,7 +155,8 @@ impl Recorder {
 
     /// Writes the rest of `trajectory.csv` and `events.csv`, a snapshot of the final state (unless that tick
     /// was drawn already), then `summary.json`: the metrics of the loop functions under `metrics`, the run
-    /// facts, and `extra` merged in at the top level. Returns the summary's path.
+    /// facts, the final pose of every movable box and cylinder under `movable_objects`, and `extra` merged in at
+    /// the top level. Returns the summary's path.
     ///
     /// The final snapshot is drawn here rather than in the last tick: drawing it there counted as tick time and
     /// made the last tick of a 2,000-robot real-time run 50 ms late.
@@ -153,11 +165,26 @@ impl Recorder {
             self.snapshot(world)?;
         }
         self.files.finish()?;
+        let movable: Vec<serde_json::Value> = world
+            .arena
+            .obstacles
+            .iter()
+            .filter(|o| matches!(o.motion, crate::physics::Motion::Movable { .. }))
+            .map(|o| {
+                serde_json::json!({
+                    "id": o.name,
+                    "x": o.placed.position.x,
+                    "y": o.placed.position.y,
+                    "angle": o.placed.angle(),
+                })
+            })
+            .collect();
         let mut summary = serde_json::json!({
             "ticks": world.tick(),
             "ticks_per_second": world.arena.ticks_per_second,
             "robots": world.robot_count(),
             "metrics": world.metrics(),
+            "movable_objects": movable,
         });
         if let (Some(map), serde_json::Value::Object(extra)) = (summary.as_object_mut(), extra) {
             map.extend(extra);

@@ -8,6 +8,7 @@ mod actuators;
 mod config;
 mod disc;
 mod footbot;
+mod gripping;
 mod run;
 mod sensors;
 mod shipped_configs;

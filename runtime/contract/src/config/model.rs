@@ -342,6 +342,10 @@ pub enum DeviceKind {
     Positioning,
     /// Our virtual gripper (thesis section "gripper"): `virtual_gripper` (sensor: holding state; actuator: grip).
     VirtualGripper,
+    /// The foot-bot's physical gripper: `footbot_gripper` (actuator; attribute `max_force`).
+    Gripper,
+    /// The foot-bot's turret, which aims the gripper: `footbot_turret` (actuator).
+    Turret,
     /// Our pheromone field sensor: `pheromone` (sensor).
     Pheromone,
     /// Our pheromone deposit: `pheromone_deposit` (actuator).

@@ -2,7 +2,7 @@
 //!
 //! Names are registry keys (as in ARGoS): the `.argos` element name finds the entry here. Both e-puck plug-ins'
 //! names are accepted (docs/epuck-and-world.md section 4.2), the foot-bot's (`footbot_proximity`, `footbot_light`,
-//! `footbot_motor_ground`), plus ours: `range_finder`, `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
+//! `footbot_motor_ground`, `footbot_gripper`, `footbot_turret`), plus ours: `range_finder`, `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
 //! name (`epuck_*`, `footbot_*`) is refused on a robot of another kind.
 
 use super::model::{DeviceKind, DeviceRole};
@@ -216,6 +216,22 @@ pub(crate) const DEVICES: &[Entry] = &[
         name: "footbot_motor_ground",
         role: S,
         kind: K::Ground,
+        medium: None,
+        attributes: &[],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_gripper",
+        role: A,
+        kind: K::Gripper,
+        medium: None,
+        attributes: &["max_force"],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_turret",
+        role: A,
+        kind: K::Turret,
         medium: None,
         attributes: &[],
         body: Some(RobotKind::FootBot),

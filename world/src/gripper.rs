@@ -1,0 +1,131 @@
+//! The physical gripper (`footbot_gripper`, with `footbot_turret` to aim it): a robot grips a movable box or
+//! cylinder by pinning it to its gripper point with a revolute joint, so that several robots can hold one object
+//! and pull or carry it together.
+//!
+//! The gripper point sits on the body's edge, in the direction of the heading plus the turret's angle. A locked
+//! gripper that holds nothing grips the first movable obstacle (in configuration order) whose outline is within
+//! [`GRIP_REACH`] of that point, after the physics step; it holds it until:
+//!
+//! - its controller unlocks it (the object is released where it is);
+//! - holding the robot back takes more than the gripper's `max_force` ([`load`]: the grip is lost under load; the
+//!   gripper then stays open until its controller unlocks and locks it again, so it does not snap back at once);
+//! - the robot dies (a dead robot's gripper opens).
+//!
+//! Each of these is a [`GripperEvent`] of the tick. While the gripper holds something the turret keeps its angle.
+
+use rapier2d::prelude::ImpulseJointHandle;
+
+use crate::arena::{Arena, GripperEvent, ReleaseCause};
+use crate::entities::{ObstacleId, RobotId};
+use crate::geometry::{Vec2, unit};
+use crate::physics::Motion;
+
+/// Largest gap in metres between the gripper point and an object's outline at which a locked gripper grips it.
+pub const GRIP_REACH: f32 = 0.01;
+/// Default largest force in newtons a grip holds before it is lost (`max_force` of `footbot_gripper`): a grip holds
+/// a foot-bot pulling at 5 cm/s against a fixed load (1.6 N) and gives when it pulls at 10 cm/s (3.2 N).
+pub const DEFAULT_MAX_FORCE: f32 = 2.5;
+
+/// What a robot's physical gripper holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Grip {
+    /// The object.
+    pub obstacle: ObstacleId,
+    /// The joint that pins it to the robot.
+    pub joint: ImpulseJointHandle,
+}
+
+/// The state of a robot's physical gripper and turret.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GripperState {
+    /// Whether the controller asked it to close.
+    pub locked: bool,
+    /// What it holds.
+    pub holding: Option<Grip>,
+    /// Whether it lost its last grip under load and waits to be unlocked before it grips again.
+    pub lost: bool,
+    /// Turret angle in radians, counter-clockwise from the heading.
+    pub turret: f32,
+}
+
+/// The arena point where robot `robot`'s gripper is.
+pub fn gripper_point(arena: &Arena, robot: RobotId) -> Option<Vec2> {
+    let r = arena.robots.get(robot.index())?;
+    Some(r.position + unit(r.heading + r.gripper.turret) * r.body.radius)
+}
+
+/// The load on robot `robot`'s grip in newtons: the force it would take to hold the robot back from the velocity
+/// its wheels commanded to the velocity it reached, `mass |v_commanded - v_reached| / tick length`. Robots are
+/// driven by setting their velocity, so this is what their motors would have to push against the grip.
+pub fn load(arena: &Arena, robot: RobotId) -> f32 {
+    let Some(r) = arena.robots.get(robot.index()) else {
+        return 0.0;
+    };
+    let (speed, _) = crate::actuators::unicycle(r.wheels, r.body.inter_wheel_distance);
+    let commanded = unit(r.heading) * speed;
+    let reached = arena.physics.velocity(r.handles.body);
+    r.body.mass * (commanded - reached).length() / arena.dt()
+}
+
+/// Lets go of what robot `robot` holds, for `cause`.
+pub fn release(arena: &mut Arena, robot: RobotId, cause: ReleaseCause) {
+    let Some(r) = arena.robots.get_mut(robot.index()) else {
+        return;
+    };
+    let Some(grip) = r.gripper.holding.take() else {
+        return;
+    };
+    arena.physics.unpin(grip.joint);
+    arena.gripper_events.push(GripperEvent::Released {
+        robot,
+        obstacle: grip.obstacle,
+        cause,
+    });
+}
+
+/// After a physics step: releases what unlocked, overloaded or dead grippers hold, then lets every locked,
+/// empty gripper grip what is within reach.
+pub fn update(arena: &mut Arena) {
+    for i in 0..arena.robots.len() {
+        let id = RobotId(i as u32);
+        let r = &arena.robots[i];
+        let Some(options) = r.devices.gripper else {
+            continue;
+        };
+        match r.gripper.holding {
+            Some(_) if !r.alive => release(arena, id, ReleaseCause::Died),
+            Some(_) if !r.gripper.locked => release(arena, id, ReleaseCause::Opened),
+            Some(_) if load(arena, id) > options.max_force => {
+                release(arena, id, ReleaseCause::Overloaded);
+                arena.robots[i].gripper.lost = true;
+            }
+            Some(_) => {}
+            None if r.alive && r.gripper.locked && !r.gripper.lost => grip(arena, id),
+            None => {}
+        }
+    }
+}
+
+/// Grips the first movable obstacle within reach of robot `robot`'s gripper point.
+fn grip(arena: &mut Arena, robot: RobotId) {
+    let Some(point) = gripper_point(arena, robot) else {
+        return;
+    };
+    let Some((index, obstacle)) = arena.obstacles.iter().enumerate().find(|(_, o)| {
+        matches!(o.motion, Motion::Movable { .. }) && o.placed.signed_distance(point) <= GRIP_REACH
+    }) else {
+        return;
+    };
+    let (robot_body, object_body) = (
+        arena.robots[robot.index()].handles.body,
+        obstacle.handles.body,
+    );
+    let Some(joint) = arena.physics.pin(robot_body, object_body, point) else {
+        return;
+    };
+    let obstacle = ObstacleId(index as u32);
+    arena.robots[robot.index()].gripper.holding = Some(Grip { obstacle, joint });
+    arena
+        .gripper_events
+        .push(GripperEvent::Gripped { robot, obstacle });
+}
