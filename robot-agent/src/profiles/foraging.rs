@@ -248,7 +248,12 @@ pub fn saw_obs<S: AsRef<Forager>>(s: &S, frame: &SensorFrame) -> bool {
 
 /// `saw-home`: the brightest light sensor is above the threshold.
 pub fn saw_home<S: AsRef<Forager>>(s: &S, frame: &SensorFrame) -> bool {
-    frame.light.iter().copied().fold(0.0f32, f32::max) > s.as_ref().theta_light
+    frame
+        .light_readings()
+        .iter()
+        .copied()
+        .fold(0.0f32, f32::max)
+        > s.as_ref().theta_light
 }
 
 /// `is-in-home`: the middle ground sensor sees the home floor.

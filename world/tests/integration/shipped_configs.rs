@@ -62,12 +62,12 @@ fn foraging_file_starts_robots_on_the_black_home_strip_with_the_lights_in_view()
     world.sense(&mut frames);
     for f in &frames {
         assert!(
-            f.ground.iter().all(|&g| g <= 0.02),
+            f.ground_readings().iter().all(|&g| g <= 0.02),
             "home is black, noise E = 0.02: {:?}",
             f.ground
         );
         assert!(
-            f.light.iter().any(|&l| l > 0.0),
+            f.light_readings().iter().any(|&l| l > 0.0),
             "every robot in home senses a home light"
         );
     }

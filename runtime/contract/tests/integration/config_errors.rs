@@ -506,7 +506,7 @@ fn other_robot_models_are_not_supported() {
     assert_error(
         &text,
         "<eye-bot",
-        "entity <eye-bot> is not supported: the world simulates e-pucks and foot-bots",
+        "entity <eye-bot> is not supported: the world simulates e-pucks, foot-bots and <disc-robot>s",
     );
 }
 
