@@ -444,3 +444,38 @@ fn two_footbots_pull_one_box_and_one_dying_lets_go() {
         "the survivor holds on until its own script lets go: {events:?}"
     );
 }
+
+#[test]
+fn runs_of_every_kind_are_a_pure_function_of_configuration_and_seed() {
+    let read = |out: &Path, file: &str| {
+        std::fs::read_to_string(out.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+    };
+    // A mixed swarm (all three bodies, three controllers) and the foraging example (random draws in the
+    // controller and in the loop functions, range and bearing between robots).
+    for (config, files, ticks) in [
+        (
+            workspace_file("configs/robots/mixed.argos"),
+            &["trajectory.csv", "events.csv"][..],
+            "200",
+        ),
+        (
+            workspace_file("configs/argos_examples/foraging.argos"),
+            &["trajectory.csv", "foraging.txt"][..],
+            "600",
+        ),
+    ] {
+        let (first, second) = (temp_dir(), temp_dir());
+        for out in [&first, &second] {
+            run_config(&config, out.path(), &["--ticks", ticks, "--seed", "42"]);
+        }
+        for file in files {
+            assert_eq!(
+                read(first.path(), file),
+                read(second.path(), file),
+                "{} differs between two runs of {}",
+                file,
+                config.display()
+            );
+        }
+    }
+}
