@@ -335,14 +335,15 @@ const IGNORED_FOOTBOT_ATTRIBUTES: &[&str] = &[
     "perspective_camera_range",
 ];
 
-/// The `<disc-robot>` body attributes, each positive and finite.
-const DISC_ATTRIBUTES: &[&str] = &[
-    "radius",
-    "height",
-    "mass",
-    "wheel_base",
-    "max_speed",
-    "max_turn_rate",
+/// The `<disc-robot>` body attributes, each above 0 and at most the bound given (far beyond any robot, and small
+/// enough to keep the physics engine's 32-bit numbers meaningful).
+const DISC_ATTRIBUTES: &[(&str, f64)] = &[
+    ("radius", 10.0),
+    ("height", 10.0),
+    ("mass", 10_000.0),
+    ("wheel_base", 20.0),
+    ("max_speed", 100.0),
+    ("max_turn_rate", 1_000.0),
 ];
 
 /// `<e-puck>`, `<foot-bot>` or `<disc-robot>`: id, range-and-bearing options, the foot-bot's camera aperture, the
@@ -354,8 +355,8 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let mut shape = DiscShape::default();
     let mut shape_ok = true;
     if kind == RobotKind::Disc {
-        known.extend_from_slice(DISC_ATTRIBUTES);
-        for (name, field) in DISC_ATTRIBUTES.iter().zip([
+        known.extend(DISC_ATTRIBUTES.iter().map(|(name, _)| *name));
+        for (&(name, max), field) in DISC_ATTRIBUTES.iter().zip([
             &mut shape.radius,
             &mut shape.height,
             &mut shape.mass,
@@ -363,8 +364,10 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
             &mut shape.max_speed,
             &mut shape.max_turn_rate,
         ]) {
-            if el.attributes.contains_key(*name) {
-                *field = ctx.positive(el, name);
+            if el.attributes.contains_key(name) {
+                *field = ctx
+                    .positive(el, name)
+                    .filter(|&v| ctx.in_range(el, name, v, 0.0, Some(max)));
                 shape_ok &= field.is_some();
             }
         }
