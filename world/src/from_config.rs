@@ -7,7 +7,7 @@
 
 use swarm_contract::bodies::RobotKind;
 use swarm_contract::config::{
-    self, Controller, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
+    self, Controller, Device, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
 use swarm_contract::messages::{MAX_RANGE_RAYS, PHEROMONE_CHANNELS, Rgb};
 
@@ -54,6 +54,13 @@ pub fn grey_level(c: Rgb) -> f32 {
     (0.299 * f32::from(c.r) + 0.587 * f32::from(c.g) + 0.114 * f32::from(c.b)) / 255.0
 }
 
+/// Attribute `name` of device `d` as a number, if given.
+fn device_number(exp: &Experiment, d: &Device, name: &str) -> Result<Option<f64>, WorldError> {
+    d.attributes
+        .parse::<f64>(name)
+        .map_err(|e| invalid(exp, e.location, e.message))
+}
+
 /// The devices a controller declares, for a robot of `kind` (whose body bounds the range-and-bearing payload).
 pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devices, WorldError> {
     let max_payload = kind.body().rab_data_size;
@@ -78,11 +85,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
     let rab = match rab_device {
         None => None,
         Some(d) => {
-            let attr = |name: &str| {
-                d.attributes
-                    .parse::<f64>(name)
-                    .map_err(|e| invalid(exp, e.location, e.message))
-            };
+            let attr = |name: &str| device_number(exp, d, name);
             let data_size = attr("data_size")?.unwrap_or(2.0);
             if !(1.0..=f64::from(max_payload)).contains(&data_size) || data_size.fract() != 0.0 {
                 return Err(invalid(
@@ -111,11 +114,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
     let range_finder = match c.sensor(DeviceKind::RangeFinder) {
         None => None,
         Some(d) => {
-            let attr = |name: &str| {
-                d.attributes
-                    .parse::<f64>(name)
-                    .map_err(|e| invalid(exp, e.location, e.message))
-            };
+            let attr = |name: &str| device_number(exp, d, name);
             let rays = attr("rays")?.unwrap_or(DEFAULT_RANGE_RAYS as f64);
             if !(1.0..=MAX_RANGE_RAYS as f64).contains(&rays) || rays.fract() != 0.0 {
                 return Err(invalid(
@@ -152,11 +151,8 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
                     ),
                 ));
             }
-            let max_force = d
-                .attributes
-                .parse::<f64>("max_force")
-                .map_err(|e| invalid(exp, e.location, e.message))?
-                .unwrap_or(f64::from(DEFAULT_MAX_FORCE));
+            let max_force =
+                device_number(exp, d, "max_force")?.unwrap_or(f64::from(DEFAULT_MAX_FORCE));
             if !(max_force > 0.0 && max_force.is_finite()) {
                 return Err(invalid(
                     exp,
@@ -171,11 +167,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
     };
     let gripper_reach = match c.actuator(DeviceKind::VirtualGripper) {
         None => GRIPPER_REACH,
-        Some(d) => d
-            .attributes
-            .parse::<f64>("pickup_gap")
-            .map_err(|e| invalid(exp, e.location, e.message))?
-            .map_or(GRIPPER_REACH, |g| g as f32),
+        Some(d) => device_number(exp, d, "pickup_gap")?.map_or(GRIPPER_REACH, |g| g as f32),
     };
     Ok(Devices {
         proximity,

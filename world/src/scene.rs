@@ -92,6 +92,22 @@ impl Scene {
         self.grid.query(aabb, |i| out.push(i));
     }
 
+    /// Fills `out` with the bodies other than `me` whose outline comes within `reach` of `centre` (possibly
+    /// repeated; a ray of length `reach` from `centre` can meet only these).
+    pub fn nearby(&self, centre: Vec2, reach: f32, me: u32, out: &mut Vec<u32>) {
+        self.gather(&Aabb::around(centre, reach), out);
+        out.retain(|&i| i != me && self.shapes[i as usize].signed_distance(centre) <= reach);
+    }
+
+    /// Distance along the ray from `origin` in direction `dir` (a unit vector) to the first of `bodies` it meets
+    /// within `range`, or infinity.
+    pub fn nearest_hit(&self, bodies: &[u32], origin: Vec2, dir: Vec2, range: f32) -> f32 {
+        bodies
+            .iter()
+            .filter_map(|&b| self.shapes[b as usize].ray_hit(origin, dir, range))
+            .fold(f32::INFINITY, f32::min)
+    }
+
     /// Whether a sight line from `from` at height `z_from` to `to` at height `z_to` is blocked by a body other
     /// than `skip_a` and `skip_b`, that is, whether a body is crossed where the line runs below the body's top.
     /// `min_height` ignores bodies lower than it.

@@ -15,7 +15,7 @@ use swarm_contract::bodies::{
 };
 
 use crate::devices::ProximityOptions;
-use crate::geometry::{Aabb, Vec2, unit};
+use crate::geometry::{Vec2, unit};
 use crate::scene::Scene;
 use crate::sensors::Observer;
 use crate::sensors::noise;
@@ -84,9 +84,7 @@ pub fn sense(
         heading,
         body,
     } = observer;
-    let reach = body.proximity_reach();
-    scene.gather(&Aabb::around(position, reach), scratch);
-    scratch.retain(|&i| i != me && scene.shapes[i as usize].signed_distance(position) <= reach);
+    scene.nearby(position, body.proximity_reach(), me, scratch);
     let (s, c) = heading.sin_cos();
     for (value, local) in out
         .iter_mut()
@@ -94,10 +92,7 @@ pub fn sense(
     {
         let dir = Vec2::new(c * local.x - s * local.y, s * local.x + c * local.y);
         let origin = position + dir * body.proximity_mount_radius;
-        let nearest = scratch
-            .iter()
-            .filter_map(|&b| scene.shapes[b as usize].ray_hit(origin, dir, body.proximity_range))
-            .fold(f32::INFINITY, f32::min);
+        let nearest = scene.nearest_hit(scratch, origin, dir, body.proximity_range);
         *value = if nearest.is_finite() {
             reading(body.proximity_curve, nearest)
         } else {

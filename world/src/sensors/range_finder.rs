@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
 use crate::devices::RangeFinderOptions;
-use crate::geometry::{Aabb, Vec2, unit};
+use crate::geometry::{Vec2, unit};
 use crate::scene::Scene;
 use crate::sensors::Observer;
 
@@ -28,20 +28,17 @@ pub fn sense(
         ..
     } = observer;
     let range = options.range;
-    scene.gather(&Aabb::around(position, range), scratch);
+    scene.nearby(position, range, me, scratch);
+    // A long range spans many grid cells, so the same body comes back many times; each ray would test it again.
     scratch.sort_unstable();
     scratch.dedup();
-    scratch.retain(|&i| i != me && scene.shapes[i as usize].signed_distance(position) <= range);
     let noise = (options.noise_std_dev > 0.0)
         .then(|| Normal::new(0.0f32, options.noise_std_dev).ok())
         .flatten();
     let step = std::f32::consts::TAU / out.len().max(1) as f32;
     for (i, value) in out.iter_mut().enumerate() {
         let dir: Vec2 = unit(heading + step * i as f32);
-        let nearest = scratch
-            .iter()
-            .filter_map(|&b| scene.shapes[b as usize].ray_hit(position, dir, range))
-            .fold(f32::INFINITY, f32::min);
+        let nearest = scene.nearest_hit(scratch, position, dir, range);
         *value = match (&noise, nearest.is_finite()) {
             (Some(normal), true) => (nearest + normal.sample(rng)).clamp(0.0, range),
             _ => nearest,

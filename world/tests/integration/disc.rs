@@ -102,34 +102,27 @@ fn range_finder_rays_measure_centre_to_surface_distances() {
     assert!(r[10].is_infinite(), "nothing behind within 1 m: {}", r[10]);
 }
 
+/// The range-finder readings of a disc robot at the origin facing +y, with a ring of `range` m, and a wall whose
+/// face is 0.5 m away in +x (90 degrees to its right, ray 15 of 20).
+fn facing_north_with_a_wall_east(range: f32) -> Vec<f32> {
+    let mut b = builder();
+    b.robot_with_body(
+        DISC,
+        "d",
+        "c",
+        Vec2::ZERO,
+        std::f32::consts::FRAC_PI_2,
+        ranging(20, range),
+    );
+    wall(&mut b, Vec2::new(0.55, 0.0), Vec2::new(0.1, 0.6));
+    let mut world = b.build();
+    frames(&mut world)[0].range_readings().to_vec()
+}
+
 #[test]
 fn range_finder_ignores_what_lies_beyond_its_range_and_turns_with_the_robot() {
-    let mut b = builder();
-    // Facing +y; the wall 0.5 m ahead in x is now at 90 degrees right (ray 15 of 20), and 0.5 m is out of a
-    // 0.4 m range.
-    b.robot_with_body(
-        DISC,
-        "d",
-        "c",
-        Vec2::ZERO,
-        std::f32::consts::FRAC_PI_2,
-        ranging(20, 0.4),
-    );
-    wall(&mut b, Vec2::new(0.55, 0.0), Vec2::new(0.1, 0.6));
-    let mut world = b.build();
-    assert!(frames(&mut world)[0].range_readings()[15].is_infinite());
-    let mut b = builder();
-    b.robot_with_body(
-        DISC,
-        "d",
-        "c",
-        Vec2::ZERO,
-        std::f32::consts::FRAC_PI_2,
-        ranging(20, 1.0),
-    );
-    wall(&mut b, Vec2::new(0.55, 0.0), Vec2::new(0.1, 0.6));
-    let mut world = b.build();
-    let r = frames(&mut world)[0].range_readings().to_vec();
+    assert!(facing_north_with_a_wall_east(0.4)[15].is_infinite());
+    let r = facing_north_with_a_wall_east(1.0);
     assert!((r[15] - 0.5).abs() < 1e-5, "{r:?}");
 }
 
