@@ -92,6 +92,8 @@ pub struct Arena {
     pub ticks_per_second: u32,
     /// Gripper events of the last tick.
     pub gripper_events: Vec<GripperEvent>,
+    /// The robots with a physical gripper, in index order (the only ones the gripper update visits).
+    pub(crate) gripping_robots: Vec<RobotId>,
     pub(crate) physics: Physics,
 }
 

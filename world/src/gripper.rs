@@ -86,8 +86,9 @@ pub fn release(arena: &mut Arena, robot: RobotId, cause: ReleaseCause) {
 /// After a physics step: releases what unlocked, overloaded or dead grippers hold, then lets every locked,
 /// empty gripper grip what is within reach.
 pub fn update(arena: &mut Arena) {
-    for i in 0..arena.robots.len() {
-        let id = RobotId(i as u32);
+    for k in 0..arena.gripping_robots.len() {
+        let id = arena.gripping_robots[k];
+        let i = id.index();
         let r = &arena.robots[i];
         let Some(options) = r.devices.gripper else {
             continue;

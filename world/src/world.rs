@@ -65,6 +65,7 @@ impl WorldBuilder {
                 tick: 0,
                 ticks_per_second,
                 gripper_events: Vec::new(),
+                gripping_robots: Vec::new(),
                 physics: Physics::new(1.0 / ticks_per_second as f32),
             },
             seed,
@@ -95,6 +96,9 @@ impl WorldBuilder {
         devices: Devices,
     ) -> RobotId {
         let id = RobotId(self.arena.robots.len() as u32);
+        if devices.gripper.is_some() {
+            self.arena.gripping_robots.push(id);
+        }
         let handles = self.arena.physics.add_robot(
             body.radius,
             body.mass,

@@ -217,13 +217,13 @@ pub const FOOTBOT: BodyModel = BodyModel {
     camera_view: CameraView::Aperture(70.0f32.to_radians()),
     rab_height: 0.1,
     rab_range: 3.0,
-    rab_data_size: 10,
+    rab_data_size: 4,
     rab_range_between_surfaces: false,
 };
 
 /// The disc robot's defaults: a TurtleBot3 Burger-like body (radius 0.105 m, 0.192 m tall, 1 kg, wheels 0.16 m
 /// apart, 0.22 m/s, 2.84 rad/s). No IR rings, ground sensors or camera; an LED on top; range-and-bearing as
-/// ARGoS' generic device (3 m, 10 bytes, centre-to-centre ranges). It senses with `range_finder`.
+/// ARGoS' generic device (3 m, 4 bytes, centre-to-centre ranges). It senses with `range_finder`.
 pub const DISC: BodyModel = BodyModel {
     kind: RobotKind::Disc,
     radius: 0.105,
@@ -245,7 +245,7 @@ pub const DISC: BodyModel = BodyModel {
     camera_view: CameraView::Disc(0.0),
     rab_height: 0.192,
     rab_range: 3.0,
-    rab_data_size: 10,
+    rab_data_size: 4,
     rab_range_between_surfaces: false,
 };
 

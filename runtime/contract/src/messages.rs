@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 5;
+pub const MESSAGE_VERSION: u32 = 6;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -26,13 +26,14 @@ pub const MAX_LIGHT_SENSORS: usize = 24;
 /// Most ground sensors a body has (the foot-bot's four motor-ground sensors; the e-puck has 3).
 pub const MAX_GROUND_SENSORS: usize = 4;
 /// Most rays of a range-finder ring (paper A's robots use 20, 18 degrees apart).
-pub const MAX_RANGE_RAYS: usize = 32;
+pub const MAX_RANGE_RAYS: usize = 24;
 /// Most LED blobs the omnidirectional camera reports per tick; further blobs (farthest first) are dropped.
 pub const MAX_CAMERA_BLOBS: usize = 16;
 /// Most range-and-bearing messages a robot receives per tick; further messages (farthest first) are dropped.
 pub const MAX_RAB_MESSAGES: usize = 16;
-/// Largest range-and-bearing payload, in bytes (the foot-bot's default 10; the IRIDIA e-puck's maximum is 4).
-pub const RAB_PAYLOAD_BYTES: usize = 10;
+/// Largest range-and-bearing payload, in bytes (the IRIDIA e-puck's maximum, for every body: each byte here is
+/// 16 bytes of every robot's frame in every tick; longer messages between robots are a medium of their own).
+pub const RAB_PAYLOAD_BYTES: usize = 4;
 /// Number of pheromone channels in the world's field (e.g. trail and home).
 pub const PHEROMONE_CHANNELS: usize = 2;
 /// Most supervisors one robot may run.
