@@ -529,7 +529,7 @@ fn a_device_of_another_robot_is_refused_where_it_is_declared() {
 }
 
 #[test]
-fn a_footbot_payload_beyond_ten_bytes_is_refused() {
+fn a_footbot_payload_beyond_four_bytes_is_refused() {
     let text = config(&[(
         "ARENA",
         r#"<foot-bot id="fb" rab_data_size="11"><body position="0,0,0"/><controller config="fdc"/></foot-bot>"#,
@@ -539,7 +539,7 @@ fn a_footbot_payload_beyond_ten_bytes_is_refused() {
     assert_error(
         &text,
         "rab_data_size=",
-        "'rab_data_size' in <foot-bot> must be between 1 and 10, got 11",
+        "'rab_data_size' in <foot-bot> must be between 1 and 4, got 11",
     );
 }
 
