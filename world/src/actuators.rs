@@ -4,8 +4,12 @@
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use std::f32::consts::TAU;
 use swarm_contract::bodies::BodyModel;
-use swarm_contract::messages::{ActuatorCommand, Drive, GripperAction, PHEROMONE_CHANNELS};
+
+use swarm_contract::messages::{
+    ActuatorCommand, Drive, GripperAction, PHEROMONE_CHANNELS, Scanner,
+};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{RobotId, TargetId, TargetState};
@@ -70,6 +74,7 @@ pub fn apply(
     command: Option<&ActuatorCommand>,
 ) {
     let i = id.index();
+    let dt = arena.dt();
     let Some(robot) = arena.robots.get_mut(i) else {
         return;
     };
@@ -113,6 +118,18 @@ pub fn apply(
         arena
             .pheromone
             .deposit(ch, position, cmd.pheromone_deposit[ch]);
+    }
+    robot.scanner.mode = cmd.scanner;
+    if cmd.scanner_setting.is_finite() {
+        match cmd.scanner {
+            Scanner::Off => {}
+            Scanner::Angle => robot.scanner.rotation = cmd.scanner_setting.rem_euclid(TAU),
+            Scanner::Speed => {
+                robot.scanner.speed = cmd.scanner_setting * TAU / 60.0;
+                robot.scanner.rotation =
+                    (robot.scanner.rotation + robot.scanner.speed * dt).rem_euclid(TAU);
+            }
+        }
     }
     if robot.devices.gripper.is_some() {
         let gripper = &mut robot.gripper;

@@ -65,6 +65,8 @@ pub struct Devices {
     pub range_finder: Option<RangeFinderOptions>,
     /// Physical gripper.
     pub gripper: Option<GripperOptions>,
+    /// The foot-bot's distance scanner (its readings; the actuator sets its mode).
+    pub distance_scanner: bool,
     /// Range-and-bearing sensor and actuator.
     pub rab: Option<RabOptions>,
     /// Multiplicative Gaussian wheel noise `noise_std_dev` (0 = none).
@@ -86,6 +88,7 @@ impl Devices {
         camera: Some(CameraOptions { noise_std_dev: 0.0 }),
         range_finder: None,
         gripper: None,
+        distance_scanner: false,
         rab: Some(RabOptions {
             data_size: 2,
             loss_probability: 0.0,
@@ -106,6 +109,7 @@ impl Devices {
         camera: None,
         range_finder: None,
         gripper: None,
+        distance_scanner: false,
         rab: None,
         wheel_noise_std_dev: 0.0,
         gripper_reach: GRIPPER_REACH,

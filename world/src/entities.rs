@@ -12,6 +12,7 @@ use crate::geometry::{Placed, Shape, Vec2};
 use crate::gripper::GripperState;
 use crate::physics::{BodyHandles, Motion};
 use crate::rng::RobotStreams;
+use crate::sensors::distance_scanner::ScannerState;
 
 /// e-puck body radius in metres (docs/epuck-and-world.md 1.1); other bodies are in `swarm_contract::bodies`.
 pub const ROBOT_RADIUS: f32 = EPUCK.radius;
@@ -80,6 +81,8 @@ pub struct Robot {
     pub carrying: Option<TargetId>,
     /// The physical gripper and turret (used when the controller declares `footbot_gripper`).
     pub gripper: GripperState,
+    /// The distance scanner's mode and turret angle.
+    pub scanner: ScannerState,
     /// Whether the loop functions gave it an item that is no body in the arena (ARGoS' foraging example's
     /// food); the frame's `gripper_holding` reports it like a carried target.
     pub holds_item: bool,

@@ -138,6 +138,17 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
             })
         }
     };
+    let distance_scanner = c.sensor(DeviceKind::DistanceScanner).is_some();
+    if let (true, Some(rf)) = (distance_scanner, c.sensor(DeviceKind::RangeFinder)) {
+        return Err(invalid(
+            exp,
+            rf.location,
+            format!(
+                "controller '{}' declares both 'range_finder' and 'footbot_distance_scanner': both report in the frame's ranges",
+                c.id
+            ),
+        ));
+    }
     let gripper = match c.actuator(DeviceKind::Gripper) {
         None => None,
         Some(d) => {
@@ -180,6 +191,7 @@ pub fn devices(exp: &Experiment, c: &Controller, kind: RobotKind) -> Result<Devi
             }),
         range_finder,
         gripper,
+        distance_scanner,
         rab,
         wheel_noise_std_dev: c
             .actuator(DeviceKind::Wheels)

@@ -28,7 +28,10 @@ use crate::media::rab::RabMedium;
 use crate::physics::{Motion, Physics};
 use crate::rng::RobotStreams;
 use crate::scene::Scene;
-use crate::sensors::{Observer, camera, ground, light, proximity, rab, range_finder};
+use crate::sensors::distance_scanner::ScannerState;
+use crate::sensors::{
+    Observer, camera, distance_scanner, ground, light, proximity, rab, range_finder,
+};
 
 /// Default range of an e-puck's range-and-bearing emitter in metres (each body has its own).
 pub const DEFAULT_RAB_RANGE: f32 = swarm_contract::bodies::EPUCK.rab_range;
@@ -121,6 +124,7 @@ impl WorldBuilder {
             wheels: [0.0; 2],
             carrying: None,
             gripper: GripperState::default(),
+            scanner: ScannerState::default(),
             holds_item: false,
             collisions: 0,
             rab_range: body.rab_range,
@@ -452,6 +456,15 @@ impl World {
                     &mut robot.rng.range_finder,
                     &mut self.scratch,
                     &mut frame.ranges[..n],
+                );
+            }
+            if devices.distance_scanner {
+                distance_scanner::sense(
+                    &self.scene,
+                    observer,
+                    &mut robot.scanner,
+                    &mut self.scratch,
+                    frame,
                 );
             }
             if let Some(opts) = &devices.camera {

@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 6;
+pub const MESSAGE_VERSION: u32 = 7;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -123,7 +123,16 @@ pub struct SensorFrame {
     pub ranges_len: u8,
     /// Range-finder readings: metres from the body centre to the nearest body along ray i (ray i at
     /// `360 i / ranges_len` degrees counter-clockwise from the heading), or infinity when nothing is within range.
+    /// The foot-bot's distance scanner fills them instead: see `scan_start`.
     pub ranges: [f32; MAX_RANGE_RAYS],
+    /// For the foot-bot's distance scanner: the angle in radians (from the heading) of its first ray's first
+    /// reading. Its four rays point `scan_start + k pi/2` (k = 0..3; rays 0 and 2 short-range, 1 and 3
+    /// long-range); `ranges` holds them ray by ray, each ray `ranges_len / 4` readings spread over `scan_span`
+    /// radians (the turn since the last tick; 0 when it does not rotate). A reading is metres from the body
+    /// centre, 0 when a body is closer than the ray's minimum distance, infinity when nothing is in reach.
+    pub scan_start: f32,
+    /// See `scan_start`.
+    pub scan_span: f32,
     /// Number of valid entries in `camera`.
     pub camera_len: u8,
     /// LED blobs seen by the omnidirectional camera, nearest first.
@@ -158,6 +167,8 @@ impl SensorFrame {
             ground: [1.0; MAX_GROUND_SENSORS],
             ranges_len: 0,
             ranges: [f32::INFINITY; MAX_RANGE_RAYS],
+            scan_start: 0.0,
+            scan_span: 0.0,
             camera_len: 0,
             camera: [CameraBlob::default(); MAX_CAMERA_BLOBS],
             rab_len: 0,
@@ -230,6 +241,19 @@ pub enum Drive {
     /// Forward speed in m/s and turn rate in rad/s (`ActuatorCommand::twist`), each clamped to the body's limit
     /// (as a TurtleBot's `cmd_vel`).
     Twist = 1,
+}
+
+/// What the foot-bot's distance scanner does (ARGoS' `Disable`, `SetAngle`/`Enable`, `SetRPM`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub enum Scanner {
+    /// Off: no readings.
+    #[default]
+    Off = 0,
+    /// Held at the angle `scanner_setting` (radians from the heading): four readings per tick.
+    Angle = 1,
+    /// Turning at `scanner_setting` revolutions per minute: 24 readings per tick over the angle swept.
+    Speed = 2,
 }
 
 /// What the virtual gripper should do this tick.
@@ -312,6 +336,10 @@ pub struct ActuatorCommand {
     pub gripper: GripperAction,
     /// The foot-bot turret's angle in radians, counter-clockwise from the heading: where the gripper faces.
     pub turret: f32,
+    /// The foot-bot distance scanner's mode.
+    pub scanner: Scanner,
+    /// Its angle in radians (`Scanner::Angle`) or speed in revolutions per minute (`Scanner::Speed`).
+    pub scanner_setting: f32,
     /// Amount of pheromone to deposit at the robot's position, per channel.
     pub pheromone_deposit: [f32; PHEROMONE_CHANNELS],
     /// Number of valid entries in `events`.
@@ -343,6 +371,8 @@ impl ActuatorCommand {
             rab_payload: [0; RAB_PAYLOAD_BYTES],
             gripper: GripperAction::Hold,
             turret: 0.0,
+            scanner: Scanner::Off,
+            scanner_setting: 0.0,
             pheromone_deposit: [0.0; PHEROMONE_CHANNELS],
             events_len: 0,
             events: [0; MAX_EVENTS_PER_TICK],

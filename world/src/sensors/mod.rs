@@ -3,6 +3,7 @@
 //! anything.
 
 pub mod camera;
+pub mod distance_scanner;
 pub mod ground;
 pub mod light;
 pub mod noise;

@@ -7,6 +7,7 @@ mod common;
 mod actuators;
 mod config;
 mod disc;
+mod distance_scanner;
 mod footbot;
 mod gripping;
 mod run;

@@ -346,6 +346,8 @@ pub enum DeviceKind {
     Gripper,
     /// The foot-bot's turret, which aims the gripper: `footbot_turret` (actuator).
     Turret,
+    /// The foot-bot's rotating distance scanner: `footbot_distance_scanner` (sensor: readings; actuator: mode).
+    DistanceScanner,
     /// Our pheromone field sensor: `pheromone` (sensor).
     Pheromone,
     /// Our pheromone deposit: `pheromone_deposit` (actuator).

@@ -2,7 +2,7 @@
 //!
 //! Names are registry keys (as in ARGoS): the `.argos` element name finds the entry here. Both e-puck plug-ins'
 //! names are accepted (docs/epuck-and-world.md section 4.2), the foot-bot's (`footbot_proximity`, `footbot_light`,
-//! `footbot_motor_ground`, `footbot_gripper`, `footbot_turret`), plus ours: `range_finder`, `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
+//! `footbot_motor_ground`, `footbot_distance_scanner`, `footbot_gripper`, `footbot_turret`), plus ours: `range_finder`, `virtual_gripper`, `pheromone` and `pheromone_deposit`. A robot-specific
 //! name (`epuck_*`, `footbot_*`) is refused on a robot of another kind.
 
 use super::model::{DeviceKind, DeviceRole};
@@ -226,6 +226,22 @@ pub(crate) const DEVICES: &[Entry] = &[
         kind: K::Gripper,
         medium: None,
         attributes: &["max_force"],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_distance_scanner",
+        role: S,
+        kind: K::DistanceScanner,
+        medium: None,
+        attributes: &[],
+        body: Some(RobotKind::FootBot),
+    },
+    Entry {
+        name: "footbot_distance_scanner",
+        role: A,
+        kind: K::DistanceScanner,
+        medium: None,
+        attributes: &[],
         body: Some(RobotKind::FootBot),
     },
     Entry {
