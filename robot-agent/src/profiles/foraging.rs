@@ -499,9 +499,12 @@ mod tests {
         Forager::from_params(&Params::new(pairs.iter().copied())).unwrap()
     }
 
+    /// An e-puck's frame with its light and ground sensors declared, as the foraging controller has them.
     fn frame(tick: u64) -> SensorFrame {
         let mut f = SensorFrame::empty(0);
         f.tick = tick;
+        f.light_len = 8;
+        f.ground_len = 3;
         f
     }
 
