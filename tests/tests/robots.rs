@@ -420,11 +420,19 @@ fn two_footbots_pull_one_box_and_one_dying_lets_go() {
         out.path(),
         &[],
     );
-    let grips: Vec<_> = gripper_and_fault_events(out.path())
-        .into_iter()
-        .filter(|e| e.2 == "gripper:grip")
-        .collect();
-    assert_eq!(grips.len(), 2, "both robots grip the box: {grips:?}");
+    let events = gripper_and_fault_events(out.path());
+    for robot in [0, 1] {
+        for (tick, event) in [
+            (70, "gripper:grip"),
+            (70, "gripper:lifted"),
+            (120, "gripper:lowered"),
+        ] {
+            assert!(
+                events.contains(&(tick, robot, event.to_owned())),
+                "robot {robot} lacks {event} at {tick}: {events:?}"
+            );
+        }
+    }
     let x = final_x(out.path(), "crate");
     assert!(x < 0.4, "the box was pulled from x = 0.57 to {x:.3}");
 
@@ -435,6 +443,10 @@ fn two_footbots_pull_one_box_and_one_dying_lets_go() {
         &["--fault", "kill robots=0 tick=90"],
     );
     let events = gripper_and_fault_events(out.path());
+    assert!(
+        events.contains(&(90, 1, "gripper:lowered".to_owned())),
+        "one grip left is not enough to hold the box up: {events:?}"
+    );
     assert!(
         events.contains(&(90, 0, "gripper:release_on_death".to_owned())),
         "{events:?}"

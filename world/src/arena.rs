@@ -57,6 +57,21 @@ pub enum GripperEvent {
         /// The object.
         obstacle: ObstacleId,
     },
+    /// Enough grippers hold an obstacle to lift it; reported for each robot holding it.
+    Lifted {
+        /// A robot holding it.
+        robot: RobotId,
+        /// The object.
+        obstacle: ObstacleId,
+    },
+    /// A lifted obstacle is back on the ground (a grip let go); reported for each robot that let go of it in
+    /// that tick and each robot still holding it.
+    Lowered {
+        /// A robot holding it.
+        robot: RobotId,
+        /// The object.
+        obstacle: ObstacleId,
+    },
     /// A robot's physical gripper let go of a movable obstacle.
     Released {
         /// The robot.
@@ -94,6 +109,8 @@ pub struct Arena {
     pub gripper_events: Vec<GripperEvent>,
     /// The robots with a physical gripper, in index order (the only ones the gripper update visits).
     pub(crate) gripping_robots: Vec<RobotId>,
+    /// The obstacles that robots can lift (`lift_by`), in index order.
+    pub(crate) liftable: Vec<ObstacleId>,
     pub(crate) physics: Physics,
 }
 

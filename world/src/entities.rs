@@ -107,6 +107,10 @@ pub struct Obstacle {
     pub height: f32,
     /// Fixed or movable.
     pub motion: Motion,
+    /// How many robots' grippers lift it off the ground (`lift_by`), if it can be lifted.
+    pub lift_by: Option<u32>,
+    /// Whether it is lifted now: held by at least `lift_by` grippers, it slides without ground friction.
+    pub lifted: bool,
     /// Physics handles.
     pub handles: BodyHandles,
 }

@@ -421,24 +421,30 @@ fn add_entity(
         Entity::Box(x) => add_passive(
             exp,
             b,
-            &x.id,
-            placed,
-            x.size.z as f32,
-            x.movable,
-            x.mass,
-            x.leds.as_ref(),
-            x.location,
+            Passive {
+                id: &x.id,
+                placed,
+                height: x.size.z as f32,
+                movable: x.movable,
+                mass: x.mass,
+                lift_by: x.lift_by,
+                leds: x.leds.as_ref(),
+                location: x.location,
+            },
         )?,
         Entity::Cylinder(x) => add_passive(
             exp,
             b,
-            &x.id,
-            placed,
-            x.height as f32,
-            x.movable,
-            x.mass,
-            x.leds.as_ref(),
-            x.location,
+            Passive {
+                id: &x.id,
+                placed,
+                height: x.height as f32,
+                movable: x.movable,
+                mass: x.mass,
+                lift_by: x.lift_by,
+                leds: x.leds.as_ref(),
+                location: x.location,
+            },
         )?,
         Entity::Target(t) => {
             b.target(&t.id, placed, t.height as f32, t.color, t.led_height as f32);
@@ -448,22 +454,37 @@ fn add_entity(
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn add_passive(
-    exp: &Experiment,
-    b: &mut WorldBuilder,
-    id: &str,
+/// A box or cylinder as `add_passive` needs it.
+struct Passive<'a> {
+    id: &'a str,
     placed: Placed,
     height: f32,
     movable: bool,
     mass: Option<f64>,
-    leds: Option<&config::LedGroup>,
+    lift_by: Option<u32>,
+    leds: Option<&'a config::LedGroup>,
     location: Location,
-) -> Result<(), WorldError> {
+}
+
+/// Adds a box or cylinder: an obstacle (liftable if it says so), or a target when it carries an LED.
+fn add_passive(exp: &Experiment, b: &mut WorldBuilder, p: Passive) -> Result<(), WorldError> {
+    let Passive {
+        id,
+        placed,
+        height,
+        movable,
+        mass,
+        lift_by,
+        leds,
+        location,
+    } = p;
     let motion = motion(exp, movable, mass, location)?;
     match leds {
         None => {
-            b.obstacle(id, placed, height, motion);
+            let obstacle = b.obstacle(id, placed, height, motion);
+            if let Some(robots) = lift_by {
+                b.lift_by(obstacle, robots);
+            }
         }
         Some(group) => {
             let [led] = group.leds.as_slice() else {

@@ -18,7 +18,7 @@ use rapier2d::prelude::ImpulseJointHandle;
 use crate::arena::{Arena, GripperEvent, ReleaseCause};
 use crate::entities::{ObstacleId, RobotId};
 use crate::geometry::{Vec2, unit};
-use crate::physics::Motion;
+use crate::physics::{MOVABLE_DAMPING, Motion};
 
 /// Largest gap in metres between the gripper point and an object's outline at which a locked gripper grips it.
 pub const GRIP_REACH: f32 = 0.01;
@@ -103,6 +103,52 @@ pub fn update(arena: &mut Arena) {
             Some(_) => {}
             None if r.alive && r.gripper.locked && !r.gripper.lost => grip(arena, id),
             None => {}
+        }
+    }
+    lift_or_lower(arena);
+}
+
+/// Lifts every liftable obstacle that at least `lift_by` grippers hold, and lowers the others: a lifted object
+/// has no ground friction (it rides on its carriers), a lowered one the friction of every movable object.
+fn lift_or_lower(arena: &mut Arena) {
+    for k in 0..arena.liftable.len() {
+        let obstacle = arena.liftable[k];
+        let holding = |r: &&RobotId| {
+            arena.robots[r.index()]
+                .gripper
+                .holding
+                .is_some_and(|g| g.obstacle == obstacle)
+        };
+        let holders = arena.gripping_robots.iter().filter(holding).count() as u32;
+        let o = &mut arena.obstacles[obstacle.index()];
+        let lifted = o.lift_by.is_some_and(|n| holders >= n);
+        if lifted == o.lifted {
+            continue;
+        }
+        o.lifted = lifted;
+        let damping = if lifted { 0.0 } else { MOVABLE_DAMPING };
+        arena.physics.set_damping(o.handles.body, damping);
+        // Reported for every robot that holds it now and, when it comes down, every robot that let go of it in
+        // this update (robot order); the events only grow, so the earlier ones are read from a copy of the count.
+        let released_now = arena.gripper_events.len();
+        for i in 0..released_now {
+            if let GripperEvent::Released {
+                robot, obstacle: o, ..
+            } = arena.gripper_events[i]
+                && o == obstacle
+                && !lifted
+            {
+                arena
+                    .gripper_events
+                    .push(GripperEvent::Lowered { robot, obstacle });
+            }
+        }
+        for &robot in arena.gripping_robots.iter().filter(holding) {
+            arena.gripper_events.push(if lifted {
+                GripperEvent::Lifted { robot, obstacle }
+            } else {
+                GripperEvent::Lowered { robot, obstacle }
+            });
         }
     }
 }

@@ -213,6 +213,14 @@ impl Physics {
         self.world.impulse_joints.remove(joint, true);
     }
 
+    /// Sets a movable body's ground friction, as linear and angular damping per second.
+    pub fn set_damping(&mut self, body: RigidBodyHandle, damping: f32) {
+        if let Some(b) = self.world.bodies.get_mut(body) {
+            b.set_linear_damping(damping);
+            b.set_angular_damping(damping);
+        }
+    }
+
     /// A body's linear velocity in m/s after the last step.
     pub fn velocity(&self, body: RigidBodyHandle) -> Vec2 {
         self.world

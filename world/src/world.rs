@@ -69,6 +69,7 @@ impl WorldBuilder {
                 ticks_per_second,
                 gripper_events: Vec::new(),
                 gripping_robots: Vec::new(),
+                liftable: Vec::new(),
                 physics: Physics::new(1.0 / ticks_per_second as f32),
             },
             seed,
@@ -172,9 +173,19 @@ impl WorldBuilder {
             placed,
             height,
             motion,
+            lift_by: None,
+            lifted: false,
             handles,
         });
         id
+    }
+
+    /// Lets `robots` grippers holding a movable obstacle at once lift it off the ground (see `gripper`).
+    pub fn lift_by(&mut self, obstacle: ObstacleId, robots: u32) {
+        if let Some(o) = self.arena.obstacles.get_mut(obstacle.index()) {
+            o.lift_by = Some(robots.max(1));
+            self.arena.liftable.push(obstacle);
+        }
     }
 
     /// Adds a target: a fixed passive body with an LED at `led_height`.
@@ -392,9 +403,12 @@ impl World {
             }
             frame.tick = tick;
             frame.robot = me;
-            frame.gripper_holding = u8::from(
-                robot.carrying.is_some() || robot.holds_item || robot.gripper.holding.is_some(),
-            );
+            frame.gripper_holding = match robot.gripper.holding {
+                Some(grip) if arena.obstacles[grip.obstacle.index()].lifted => 2,
+                Some(_) => 1,
+                None => u8::from(robot.carrying.is_some() || robot.holds_item),
+            };
+            frame.held_object = robot.gripper.holding.map_or(0, |g| g.obstacle.0 + 1);
             frame.position = [robot.position.x, robot.position.y];
             frame.heading = robot.heading;
             if !robot.alive {

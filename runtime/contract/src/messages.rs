@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 7;
+pub const MESSAGE_VERSION: u32 = 8;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -101,26 +101,34 @@ pub struct SensorFrame {
     pub tick: u64,
     /// Index of the robot in the run (0..N).
     pub robot: u32,
+    /// What the physical gripper holds: 1 + the object's index among the arena's boxes and cylinders in
+    /// configuration order (`summary.json`'s `movable_objects` give each one's `index`); 0 when it holds nothing.
+    pub held_object: u32,
     /// Non-zero while the robot is alive in the world.
     pub alive: u8,
-    /// Non-zero while the robot carries an object with its virtual gripper.
+    /// Non-zero while the robot holds something: 1 a target of the virtual gripper, an object of the physical
+    /// gripper or an item the loop functions gave it; 2 an object of the physical gripper that is lifted.
     pub gripper_holding: u8,
     /// Number of valid entries in `proximity` (the body's sensor count; 0 when the sensor is not declared).
     pub proximity_len: u8,
+    /// Number of valid entries in `light`.
+    pub light_len: u8,
+    /// Number of valid entries in `ground`.
+    pub ground_len: u8,
+    /// Number of valid entries in `ranges` (the range finder's ray count; 0 when it is not declared).
+    pub ranges_len: u8,
+    /// Number of valid entries in `camera`.
+    pub camera_len: u8,
+    /// Number of valid entries in `rab`.
+    pub rab_len: u8,
     /// Proximity readings in [0, 1] (0 nothing, 1 touching), sensor i at the body's i-th proximity angle
     /// (`crate::bodies::BodyModel::proximity_angles_deg`).
     pub proximity: [f32; MAX_PROXIMITY_SENSORS],
-    /// Number of valid entries in `light`.
-    pub light_len: u8,
     /// Light readings in [0, 1], sensor i at the body's i-th light angle.
     pub light: [f32; MAX_LIGHT_SENSORS],
-    /// Number of valid entries in `ground`.
-    pub ground_len: u8,
     /// Ground readings in [0, 1] (1 white, 0 black), in the body's ground-sensor order (e-puck: index 0 is the
     /// left sensor).
     pub ground: [f32; MAX_GROUND_SENSORS],
-    /// Number of valid entries in `ranges` (the range finder's ray count; 0 when it is not declared).
-    pub ranges_len: u8,
     /// Range-finder readings: metres from the body centre to the nearest body along ray i (ray i at
     /// `360 i / ranges_len` degrees counter-clockwise from the heading), or infinity when nothing is within range.
     /// The foot-bot's distance scanner fills them instead: see `scan_start`.
@@ -133,12 +141,8 @@ pub struct SensorFrame {
     pub scan_start: f32,
     /// See `scan_start`.
     pub scan_span: f32,
-    /// Number of valid entries in `camera`.
-    pub camera_len: u8,
     /// LED blobs seen by the omnidirectional camera, nearest first.
     pub camera: [CameraBlob; MAX_CAMERA_BLOBS],
-    /// Number of valid entries in `rab`.
-    pub rab_len: u8,
     /// Range-and-bearing messages received, nearest first.
     pub rab: [RabMessage; MAX_RAB_MESSAGES],
     /// Pheromone concentration at the robot's position, per channel.
@@ -157,6 +161,7 @@ impl SensorFrame {
         Self {
             tick: 0,
             robot,
+            held_object: 0,
             alive: 1,
             gripper_holding: 0,
             proximity_len: 0,

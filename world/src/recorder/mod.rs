@@ -118,7 +118,7 @@ impl Recorder {
     }
 
     /// Ends the world's current tick: the physical grippers' events of the tick (`gripper:grip`,
-    /// `gripper:release`, `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded
+    /// `gripper:lifted`, `gripper:lowered`, `gripper:release`, `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded
     /// since the last tick go to the writing thread, and a snapshot is drawn if this tick is scheduled.
     pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
         if let Some(output) = &mut self.loop_output {
@@ -128,6 +128,8 @@ impl Recorder {
         for event in &world.arena.gripper_events {
             let (robot, name) = match *event {
                 GripperEvent::Gripped { robot, .. } => (robot, "gripper:grip"),
+                GripperEvent::Lifted { robot, .. } => (robot, "gripper:lifted"),
+                GripperEvent::Lowered { robot, .. } => (robot, "gripper:lowered"),
                 GripperEvent::Released { robot, cause, .. } => (robot, cause.event_name()),
                 GripperEvent::Picked { .. } | GripperEvent::Dropped { .. } => continue,
             };
@@ -169,13 +171,16 @@ impl Recorder {
             .arena
             .obstacles
             .iter()
-            .filter(|o| matches!(o.motion, crate::physics::Motion::Movable { .. }))
-            .map(|o| {
+            .enumerate()
+            .filter(|(_, o)| matches!(o.motion, crate::physics::Motion::Movable { .. }))
+            .map(|(index, o)| {
                 serde_json::json!({
                     "id": o.name,
+                    "index": index,
                     "x": o.placed.position.x,
                     "y": o.placed.position.y,
                     "angle": o.placed.angle(),
+                    "lifted": o.lifted,
                 })
             })
             .collect();

@@ -39,6 +39,7 @@ fn wall(id: &str, size: Vec3, x: f64, y: f64, line: u32) -> PlacedEntity {
             size,
             movable: false,
             mass: None,
+            lift_by: None,
             leds: None,
             location: at(line),
         }),
@@ -99,6 +100,7 @@ pub fn thesis_example() -> Experiment {
         size: Vec3::new(0.1, 0.1, 0.4),
         movable: false,
         mass: None,
+        lift_by: None,
         leds: None,
         location: at(48),
     });
@@ -108,6 +110,7 @@ pub fn thesis_example() -> Experiment {
         height: 0.4,
         movable: false,
         mass: None,
+        lift_by: None,
         leds: None,
         location: at(58),
     });

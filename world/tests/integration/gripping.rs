@@ -77,6 +77,7 @@ fn a_locked_gripper_grips_what_touches_it_pulls_it_and_lets_go_when_unlocked() {
     let mut frames = vec![swarm_contract::messages::SensorFrame::empty(0)];
     world.sense(&mut frames);
     assert_eq!(frames[0].gripper_holding, 1, "the frame reports the grip");
+    assert_eq!(frames[0].held_object, 1, "and what it holds: object 0");
     for _ in 0..40 {
         step(&mut world, &[command([-5.0, -5.0], GripperAction::Pick)]);
     }
@@ -300,4 +301,90 @@ fn the_turret_aims_the_gripper() {
     left.turret = std::f32::consts::FRAC_PI_2;
     step(&mut world, &[left]);
     assert_eq!(holding(&world, 0), Some(ObstacleId(0)));
+}
+
+/// A heavy box (20 kg) at the origin that `lift_by` grippers lift, and two foot-bots on its west side gripping it.
+fn two_robots_and_a_heavy_box(lift_by: Option<u32>) -> World {
+    let mut b = builder();
+    footbot(&mut b, -(0.15 + R + 0.005), 0.1, 0.0);
+    footbot(&mut b, -(0.15 + R + 0.005), -0.1, 0.0);
+    let the_box = b.obstacle(
+        "box",
+        Placed::new(
+            Shape::Rect {
+                half: Vec2::splat(0.15),
+            },
+            Vec2::ZERO,
+            0.0,
+        ),
+        0.2,
+        Motion::Movable { mass: 20.0 },
+    );
+    if let Some(n) = lift_by {
+        b.lift_by(the_box, n);
+    }
+    b.build()
+}
+
+#[test]
+fn enough_grippers_lift_an_object_and_one_letting_go_lowers_it() {
+    let mut world = two_robots_and_a_heavy_box(Some(2));
+    let lock = command([0.0; 2], GripperAction::Pick);
+    let events = step(&mut world, &[lock, lock]);
+    for robot in [RobotId(0), RobotId(1)] {
+        assert!(
+            events.contains(&GripperEvent::Lifted {
+                robot,
+                obstacle: ObstacleId(0)
+            }),
+            "{events:?}"
+        );
+    }
+    assert!(world.arena.obstacles[0].lifted);
+    let mut frames = vec![swarm_contract::messages::SensorFrame::empty(0); 2];
+    world.sense(&mut frames);
+    assert_eq!(
+        (frames[0].gripper_holding, frames[1].gripper_holding),
+        (2, 2),
+        "the frame says the held object is lifted"
+    );
+    let events = step(&mut world, &[lock, command([0.0; 2], GripperAction::Drop)]);
+    assert!(
+        events.contains(&GripperEvent::Lowered {
+            robot: RobotId(0),
+            obstacle: ObstacleId(0)
+        }),
+        "{events:?}"
+    );
+    assert!(!world.arena.obstacles[0].lifted);
+}
+
+#[test]
+fn a_lifted_object_loses_its_ground_friction() {
+    // Both pull west at 5 cm/s for 2 s; the 20 kg box drags on the ground unless it is lifted.
+    let pulled = |lift_by| {
+        let mut world = two_robots_and_a_heavy_box(lift_by);
+        let lock = command([0.0; 2], GripperAction::Pick);
+        step(&mut world, &[lock, lock]);
+        let back = command([-5.0, -5.0], GripperAction::Pick);
+        let mut lost = false;
+        for _ in 0..40 {
+            lost |= step(&mut world, &[back, back])
+                .iter()
+                .any(|e| matches!(e, GripperEvent::Released { .. }));
+        }
+        (-world.arena.obstacles[0].placed.position.x, lost)
+    };
+    let (dragged, dragged_lost) = pulled(None);
+    let (carried, carried_lost) = pulled(Some(2));
+    assert!(!carried_lost, "a lifted box does not overload the grips");
+    assert!(
+        carried > dragged + 0.01 || dragged_lost,
+        "lifted it goes {carried:.3} m, dragged {dragged:.3} m (grips lost: {dragged_lost})"
+    );
+    // The 20 kg box still has to be set moving by two 1.6 kg robots: it lags behind their 0.1 m at first.
+    assert!(
+        carried > 0.07,
+        "carried {carried:.3} m of the 0.1 m the robots drove"
+    );
 }

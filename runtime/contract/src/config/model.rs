@@ -565,6 +565,8 @@ pub struct BoxEntity {
     pub movable: bool,
     /// `mass` in kg; present exactly when `movable` is true.
     pub mass: Option<f64>,
+    /// `lift_by` (ours): how many robots' grippers lift it off the ground; only on a movable box.
+    pub lift_by: Option<u32>,
     /// `<leds>` on the box, if any.
     pub leds: Option<LedGroup>,
     /// Where the element is.
@@ -584,6 +586,8 @@ pub struct CylinderEntity {
     pub movable: bool,
     /// `mass` in kg; present exactly when `movable` is true.
     pub mass: Option<f64>,
+    /// `lift_by` (ours): how many robots' grippers lift it off the ground; only on a movable cylinder.
+    pub lift_by: Option<u32>,
     /// `<leds>` on the cylinder (ARGoS passive objects with LEDs), if any.
     pub leds: Option<LedGroup>,
     /// Where the element is.

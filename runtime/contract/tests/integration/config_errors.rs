@@ -529,6 +529,28 @@ fn a_device_of_another_robot_is_refused_where_it_is_declared() {
 }
 
 #[test]
+fn only_a_movable_object_can_be_lifted() {
+    let text = config(&[(
+        "ARENA",
+        r#"<box id="b" size="0.3,0.3,0.2" movable="false" lift_by="2"><body position="0,0,0"/></box>"#,
+    )]);
+    assert_error(
+        &text,
+        "lift_by=",
+        "'lift_by' needs a movable <box> (movable=\"true\" and a mass)",
+    );
+    let text = config(&[(
+        "ARENA",
+        r#"<cylinder id="c" radius="0.1" height="0.2" movable="true" mass="1" lift_by="0"><body position="0,0,0"/></cylinder>"#,
+    )]);
+    assert_error(
+        &text,
+        "lift_by=",
+        "'lift_by' in <cylinder> must be between 1 and 64, got 0",
+    );
+}
+
+#[test]
 fn a_footbot_payload_beyond_four_bytes_is_refused() {
     let text = config(&[(
         "ARENA",

@@ -193,6 +193,50 @@ fn parse_body(ctx: &mut Ctx, el: &Element) -> Option<Pose> {
 }
 
 /// `movable` (default false) and `mass`, which a movable entity must have.
+/// Most robots a `lift_by` may ask for.
+const MAX_LIFT_BY: f64 = 64.0;
+
+/// `movable`, `mass` and `lift_by` of a box or cylinder.
+struct Mobility {
+    movable: bool,
+    mass: Option<f64>,
+    lift_by: Option<u32>,
+}
+
+/// `movable` (default false), `mass` (which a movable entity must have) and `lift_by` (ours: how many robots'
+/// grippers lift it; only on a movable entity).
+fn mobility(ctx: &mut Ctx, el: &Element) -> Option<Mobility> {
+    let lift_by = match el.attributes.get("lift_by") {
+        None => Some(None),
+        Some(_) => ctx.attr::<u32>(el, "lift_by").and_then(|n| {
+            ctx.in_range(el, "lift_by", f64::from(n), 1.0, Some(MAX_LIFT_BY))
+                .then_some(Some(n))
+        }),
+    };
+    let (movable, mass) = movable_mass(ctx, el)?;
+    let lift_by = lift_by?;
+    if let (false, Some(_)) = (movable, lift_by) {
+        let at = el
+            .attributes
+            .get("lift_by")
+            .map_or(el.location, |a| a.location);
+        ctx.error(
+            at,
+            format!(
+                "'lift_by' needs a movable <{}> (movable=\"true\" and a mass)",
+                el.name
+            ),
+            None,
+        );
+        return None;
+    }
+    Some(Mobility {
+        movable,
+        mass,
+        lift_by,
+    })
+}
+
 fn movable_mass(ctx: &mut Ctx, el: &Element) -> Option<(bool, Option<f64>)> {
     let movable: bool = ctx.attr(el, "movable").unwrap_or(false);
     if !movable {
@@ -217,7 +261,7 @@ fn movable_mass(ctx: &mut Ctx, el: &Element) -> Option<(bool, Option<f64>)> {
 }
 
 fn box_entity(ctx: &mut Ctx, el: &Element) -> Option<BoxEntity> {
-    ctx.unknown_attributes(el, &["id", "size", "movable", "mass"]);
+    ctx.unknown_attributes(el, &["id", "size", "movable", "mass", "lift_by"]);
     let id: Option<String> = ctx.required(el, "id");
     let size: Option<Vec3> = ctx.required(el, "size");
     let size = size.filter(|s| {
@@ -235,33 +279,46 @@ fn box_entity(ctx: &mut Ctx, el: &Element) -> Option<BoxEntity> {
         }
         ok
     });
-    let movable = movable_mass(ctx, el);
+    let mobility = mobility(ctx, el);
     let leds = led_group(ctx, el);
-    let (movable, mass) = movable?;
+    let Mobility {
+        movable,
+        mass,
+        lift_by,
+    } = mobility?;
     Some(BoxEntity {
         id: id?,
         size: size?,
         movable,
         mass,
+        lift_by,
         leds: leds?,
         location: el.location,
     })
 }
 
 fn cylinder(ctx: &mut Ctx, el: &Element) -> Option<CylinderEntity> {
-    ctx.unknown_attributes(el, &["id", "radius", "height", "movable", "mass"]);
+    ctx.unknown_attributes(
+        el,
+        &["id", "radius", "height", "movable", "mass", "lift_by"],
+    );
     let id: Option<String> = ctx.required(el, "id");
     let radius = ctx.positive(el, "radius");
     let height = ctx.positive(el, "height");
-    let movable = movable_mass(ctx, el);
+    let mobility = mobility(ctx, el);
     let leds = led_group(ctx, el);
-    let (movable, mass) = movable?;
+    let Mobility {
+        movable,
+        mass,
+        lift_by,
+    } = mobility?;
     Some(CylinderEntity {
         id: id?,
         radius: radius?,
         height: height?,
         movable,
         mass,
+        lift_by,
         leds: leds?,
         location: el.location,
     })
