@@ -144,9 +144,7 @@ pub fn apply(
                 }
             }
         }
-        if gripper.holding.is_none() && cmd.turret.is_finite() {
-            gripper.turret = crate::geometry::wrap_angle(cmd.turret);
-        }
+        crate::gripper::command_turret(arena, id, cmd.turret_mode, cmd.turret, dt);
         return;
     }
     match cmd.gripper {

@@ -1,6 +1,9 @@
-//! The physical gripper (`footbot_gripper`, with `footbot_turret` to aim it): a robot grips a movable box or
-//! cylinder by pinning it to its gripper point with a revolute joint, so that several robots can hold one object
-//! and pull or carry it together.
+//! The physical gripper (`footbot_gripper`, with `footbot_turret` to turn it): a robot grips a movable box or
+//! cylinder at its gripper point, so that several robots can hold one object and pull or carry it together.
+//!
+//! As on ARGoS' foot-bot, the object is held rigidly by the turret, and the turret turns about the robot's centre:
+//! in position or speed mode the object is welded to the turret's frame (rapier fixed joint) and turns with it; a
+//! passive turret turns freely, so the object is pinned to the robot's centre by a revolute joint.
 //!
 //! The gripper point sits on the body's edge, in the direction of the heading plus the turret's angle. A locked
 //! gripper that holds nothing grips the first movable obstacle (in configuration order) whose outline is within
@@ -11,7 +14,8 @@
 //!   gripper then stays open until its controller unlocks and locks it again, so it does not snap back at once);
 //! - the robot dies (a dead robot's gripper opens).
 //!
-//! Each of these is a [`GripperEvent`] of the tick. While the gripper holds something the turret keeps its angle.
+//! Each of these is a [`GripperEvent`] of the tick. The turret turns at most [`TURRET_MAX_SPEED`]: a sudden turn
+//! would yank the object out of the gripper.
 
 use rapier2d::prelude::ImpulseJointHandle;
 
@@ -19,6 +23,7 @@ use crate::arena::{Arena, GripperEvent, ReleaseCause};
 use crate::entities::{ObstacleId, RobotId};
 use crate::geometry::{Vec2, unit};
 use crate::physics::{MOVABLE_DAMPING, Motion};
+use swarm_contract::messages::Turret;
 
 /// Largest gap in metres between the gripper point and an object's outline at which a locked gripper grips it.
 pub const GRIP_REACH: f32 = 0.01;
@@ -26,13 +31,21 @@ pub const GRIP_REACH: f32 = 0.01;
 /// a foot-bot pulling at 5 cm/s against a fixed load (1.6 N) and gives when it pulls at 10 cm/s (3.2 N).
 pub const DEFAULT_MAX_FORCE: f32 = 2.5;
 
+/// Fastest the turret turns, in radians per second: a position command gets there at this speed, a speed
+/// command is capped at it.
+pub const TURRET_MAX_SPEED: f32 = std::f32::consts::PI;
+
 /// What a robot's physical gripper holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Grip {
     /// The object.
     pub obstacle: ObstacleId,
-    /// The joint that pins it to the robot.
+    /// The joint that holds it to the robot.
     pub joint: ImpulseJointHandle,
+    /// Whether the joint is the passive turret's (revolute at the robot's centre) rather than a weld.
+    pub passive: bool,
+    /// Where the gripper holds the object, in the object's frame.
+    pub point_on_object: Vec2,
 }
 
 /// The state of a robot's physical gripper and turret.
@@ -46,6 +59,8 @@ pub struct GripperState {
     pub lost: bool,
     /// Turret angle in radians, counter-clockwise from the heading.
     pub turret: f32,
+    /// How the turret moves.
+    pub turret_mode: Turret,
 }
 
 /// The arena point where robot `robot`'s gripper is.
@@ -89,6 +104,7 @@ pub fn update(arena: &mut Arena) {
     for k in 0..arena.gripping_robots.len() {
         let id = arena.gripping_robots[k];
         let i = id.index();
+        follow_passively(arena, id);
         let r = &arena.robots[i];
         let Some(options) = r.devices.gripper else {
             continue;
@@ -153,6 +169,86 @@ fn lift_or_lower(arena: &mut Arena) {
     }
 }
 
+/// Keeps a passive turret's angle pointing at where the held object is gripped (the joint lets it turn freely;
+/// this only keeps the gripper point where the object is).
+fn follow_passively(arena: &mut Arena, robot: RobotId) {
+    let r = &arena.robots[robot.index()];
+    let Some(grip) = r.gripper.holding.filter(|g| g.passive) else {
+        return;
+    };
+    let object = arena.obstacles[grip.obstacle.index()].handles.body;
+    let Some(point) = arena.physics.point_on(object, grip.point_on_object) else {
+        return;
+    };
+    let to = point - r.position;
+    let turret = crate::geometry::wrap_angle(to.y.atan2(to.x) - r.heading);
+    arena.robots[robot.index()].gripper.turret = turret;
+}
+
+/// The joint that holds `object` to robot `robot` as things are now: a weld at the turret's frame, or for a
+/// passive turret a revolute joint at the robot's centre.
+fn attach(
+    arena: &mut Arena,
+    robot: RobotId,
+    object: ObstacleId,
+) -> Option<(ImpulseJointHandle, bool)> {
+    let r = &arena.robots[robot.index()];
+    let (robot_body, centre, turret, radius) =
+        (r.handles.body, r.position, r.gripper.turret, r.body.radius);
+    let passive = r.gripper.turret_mode == Turret::Passive;
+    let object_body = arena.obstacles[object.index()].handles.body;
+    let joint = if passive {
+        arena.physics.pin(robot_body, object_body, centre)?
+    } else {
+        arena
+            .physics
+            .weld(robot_body, object_body, unit(turret) * radius, turret)?
+    };
+    Some((joint, passive))
+}
+
+/// Applies a turret command to robot `robot`: its mode, and its angle (`Position`) or speed (`Speed`) in the tick
+/// of `dt` seconds; a held object turns with it, and changing to or from passive changes how it is held.
+pub fn command_turret(arena: &mut Arena, robot: RobotId, mode: Turret, setting: f32, dt: f32) {
+    let Some(r) = arena.robots.get_mut(robot.index()) else {
+        return;
+    };
+    let gripper = &mut r.gripper;
+    gripper.turret_mode = mode;
+    let step = TURRET_MAX_SPEED * dt;
+    let turned = match mode {
+        Turret::Position if setting.is_finite() => {
+            let to_go = crate::geometry::wrap_angle(setting - gripper.turret);
+            Some(gripper.turret + to_go.clamp(-step, step))
+        }
+        Turret::Speed if setting.is_finite() => {
+            Some(gripper.turret + (setting * dt).clamp(-step, step))
+        }
+        _ => None,
+    };
+    if let Some(angle) = turned {
+        gripper.turret = crate::geometry::wrap_angle(angle);
+    }
+    let (turret, radius) = (gripper.turret, r.body.radius);
+    let Some(grip) = gripper.holding else {
+        return;
+    };
+    if grip.passive != (mode == Turret::Passive) {
+        arena.physics.unpin(grip.joint);
+        if let Some((joint, passive)) = attach(arena, robot, grip.obstacle) {
+            arena.robots[robot.index()].gripper.holding = Some(Grip {
+                joint,
+                passive,
+                ..grip
+            });
+        }
+    } else if !grip.passive {
+        arena
+            .physics
+            .move_weld(grip.joint, unit(turret) * radius, turret);
+    }
+}
+
 /// Grips the first movable obstacle within reach of robot `robot`'s gripper point.
 fn grip(arena: &mut Arena, robot: RobotId) {
     let Some(point) = gripper_point(arena, robot) else {
@@ -163,15 +259,19 @@ fn grip(arena: &mut Arena, robot: RobotId) {
     }) else {
         return;
     };
-    let (robot_body, object_body) = (
-        arena.robots[robot.index()].handles.body,
-        obstacle.handles.body,
-    );
-    let Some(joint) = arena.physics.pin(robot_body, object_body, point) else {
+    let Some(point_on_object) = arena.physics.local_point(obstacle.handles.body, point) else {
         return;
     };
     let obstacle = ObstacleId(index as u32);
-    arena.robots[robot.index()].gripper.holding = Some(Grip { obstacle, joint });
+    let Some((joint, passive)) = attach(arena, robot, obstacle) else {
+        return;
+    };
+    arena.robots[robot.index()].gripper.holding = Some(Grip {
+        obstacle,
+        joint,
+        passive,
+        point_on_object,
+    });
     arena
         .gripper_events
         .push(GripperEvent::Gripped { robot, obstacle });

@@ -7,10 +7,12 @@
 
 use std::sync::Mutex;
 
+use rapier2d::math::Pose;
 use rapier2d::prelude::{
     ActiveEvents, ColliderBuilder, ColliderHandle, ColliderSet, CollisionEvent, ContactPair,
-    EventHandler, ImpulseJointHandle, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
-    RigidBodyHandle, RigidBodySet, SoftBodySet, SoftBodyTearEvent,
+    EventHandler, FixedJointBuilder, ImpulseJointHandle, MassProperties, PhysicsWorld,
+    RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet,
+    SoftBodyTearEvent,
 };
 
 use crate::geometry::{Shape, Vec2};
@@ -159,6 +161,14 @@ impl Physics {
         BodyHandles { body, collider }
     }
 
+    /// Adds rotational inertia to a robot's body (`extra` in kg m^2): its wheels then hold the base against
+    /// reaction torques, such as its own turret turning a held object.
+    pub fn hold_rotation(&mut self, body: RigidBodyHandle, extra: f32) {
+        if let Some(b) = self.world.bodies.get_mut(body) {
+            b.set_additional_mass_properties(MassProperties::new(Vec2::ZERO, 0.0, extra), true);
+        }
+    }
+
     /// Sets a robot's linear speed along its heading (m/s) and its turn rate (rad/s) for the next step.
     pub fn drive(&mut self, body: RigidBodyHandle, speed: f32, turn_rate: f32) {
         if let Some(b) = self.world.bodies.get_mut(body) {
@@ -206,6 +216,47 @@ impl Physics {
             .contacts_enabled(false)
             .build();
         Some(self.world.impulse_joints.insert(body1, body2, joint, true))
+    }
+
+    /// Welds `body2` to `body1` as they are now, at the frame `(anchor, angle)` of `body1` (a gripper's point and
+    /// direction): the second body then moves and turns with that frame.
+    pub fn weld(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        anchor: Vec2,
+        angle: f32,
+    ) -> Option<ImpulseJointHandle> {
+        let pose = |h: RigidBodyHandle| self.world.bodies.get(h).map(|b| *b.position());
+        let (pose1, pose2) = (pose(body1)?, pose(body2)?);
+        let frame1 = Pose::new(anchor, angle);
+        let frame2 = pose2.inverse() * pose1 * frame1;
+        let joint = FixedJointBuilder::new()
+            .local_frame1(frame1)
+            .local_frame2(frame2)
+            .contacts_enabled(false)
+            .build();
+        Some(self.world.impulse_joints.insert(body1, body2, joint, true))
+    }
+
+    /// Moves a weld's frame on its first body to `(anchor, angle)`: the solver carries the second body along (a
+    /// turret turning a held object).
+    pub fn move_weld(&mut self, joint: ImpulseJointHandle, anchor: Vec2, angle: f32) {
+        if let Some(j) = self.world.impulse_joints.get_mut(joint, true) {
+            j.data.set_local_frame1(Pose::new(anchor, angle));
+        }
+    }
+
+    /// Where `local` (a point in `body`'s frame) is in the arena now.
+    pub fn point_on(&self, body: RigidBodyHandle, local: Vec2) -> Option<Vec2> {
+        let b = self.world.bodies.get(body)?;
+        Some(b.position().transform_point(local))
+    }
+
+    /// Where the arena point `at` lies in `body`'s frame now.
+    pub fn local_point(&self, body: RigidBodyHandle, at: Vec2) -> Option<Vec2> {
+        let b = self.world.bodies.get(body)?;
+        Some(b.position().inverse_transform_point(at))
     }
 
     /// Removes a joint made by [`Physics::pin`].

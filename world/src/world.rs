@@ -100,9 +100,6 @@ impl WorldBuilder {
         devices: Devices,
     ) -> RobotId {
         let id = RobotId(self.arena.robots.len() as u32);
-        if devices.gripper.is_some() {
-            self.arena.gripping_robots.push(id);
-        }
         let handles = self.arena.physics.add_robot(
             body.radius,
             body.mass,
@@ -110,6 +107,14 @@ impl WorldBuilder {
             heading,
             TAG_ROBOT | u128::from(id.0),
         );
+        if devices.gripper.is_some() {
+            self.arena.gripping_robots.push(id);
+            // A hundred times the disc's own inertia: what it holds turns with its turret, not its base.
+            let inertia = 0.5 * body.mass * body.radius * body.radius;
+            self.arena
+                .physics
+                .hold_rotation(handles.body, 100.0 * inertia);
+        }
         self.arena.robots.push(Robot {
             name: name.to_owned(),
             body,

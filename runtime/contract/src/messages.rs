@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 8;
+pub const MESSAGE_VERSION: u32 = 9;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -261,6 +261,19 @@ pub enum Scanner {
     Speed = 2,
 }
 
+/// How the foot-bot's turret moves (ARGoS' turret modes).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
+#[repr(C)]
+pub enum Turret {
+    /// Turned to `turret` radians from the heading.
+    #[default]
+    Position = 0,
+    /// Turning at `turret` radians per second (0 holds it where it is).
+    Speed = 1,
+    /// Free: it turns wherever a held object pulls it.
+    Passive = 2,
+}
+
 /// What the virtual gripper should do this tick.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, Encode, Decode)]
 #[repr(C)]
@@ -339,7 +352,10 @@ pub struct ActuatorCommand {
     /// Gripper action: for the virtual gripper, pick or drop a target; for the foot-bot's physical gripper,
     /// `Pick` locks it (it grips what comes within reach) and `Drop` unlocks it.
     pub gripper: GripperAction,
-    /// The foot-bot turret's angle in radians, counter-clockwise from the heading: where the gripper faces.
+    /// How the foot-bot's turret moves.
+    pub turret_mode: Turret,
+    /// The turret's angle in radians, counter-clockwise from the heading (`Turret::Position`: where the gripper
+    /// faces), or its speed in radians per second (`Turret::Speed`).
     pub turret: f32,
     /// The foot-bot distance scanner's mode.
     pub scanner: Scanner,
@@ -375,6 +391,7 @@ impl ActuatorCommand {
             rab_len: 0,
             rab_payload: [0; RAB_PAYLOAD_BYTES],
             gripper: GripperAction::Hold,
+            turret_mode: Turret::Position,
             turret: 0.0,
             scanner: Scanner::Off,
             scanner_setting: 0.0,

@@ -1,7 +1,7 @@
 //! The physical gripper: gripping, pulling, several robots carrying one box, releasing, losing grip under load,
 //! a robot dying while gripping, and the turret.
 
-use crate::common::builder;
+use crate::common::{TPS, builder};
 use swarm_contract::bodies::FOOTBOT;
 use swarm_contract::messages::{ActuatorCommand, GripperAction};
 use swarm_world::World;
@@ -299,7 +299,10 @@ fn the_turret_aims_the_gripper() {
     step(&mut world, &[ahead]);
     let mut left = command([0.0; 2], GripperAction::Pick);
     left.turret = std::f32::consts::FRAC_PI_2;
-    step(&mut world, &[left]);
+    // The turret turns at most pi rad/s: a quarter turn takes ten ticks at 20 ticks/s.
+    for _ in 0..11 {
+        step(&mut world, &[left]);
+    }
     assert_eq!(holding(&world, 0), Some(ObstacleId(0)));
 }
 
@@ -386,5 +389,82 @@ fn a_lifted_object_loses_its_ground_friction() {
     assert!(
         carried > 0.07,
         "carried {carried:.3} m of the 0.1 m the robots drove"
+    );
+}
+
+/// A foot-bot at the origin facing +x holding a light cylinder just ahead of it.
+fn holding_a_cylinder_ahead() -> World {
+    let mut b = builder();
+    footbot(&mut b, 0.0, 0.0, 0.0);
+    cylinder(&mut b, R + 0.005 + 0.1, MOVABLE);
+    let mut world = b.build();
+    step(&mut world, &[command([0.0; 2], GripperAction::Pick)]);
+    assert_eq!(holding(&world, 0), Some(ObstacleId(0)));
+    world
+}
+
+/// Direction from the robot to the object, radians in the arena frame.
+fn bearing_of_object(world: &World) -> f32 {
+    let d = world.arena.obstacles[0].placed.position - world.arena.robots[0].position;
+    d.y.atan2(d.x)
+}
+
+#[test]
+fn turning_the_turret_carries_the_held_object_round() {
+    let mut world = holding_a_cylinder_ahead();
+    let mut turn = command([0.0; 2], GripperAction::Pick);
+    turn.turret = std::f32::consts::FRAC_PI_2;
+    for _ in 0..40 {
+        step(&mut world, &[turn]);
+    }
+    let bearing = bearing_of_object(&world);
+    assert!(
+        (bearing - std::f32::consts::FRAC_PI_2).abs() < 0.15,
+        "the object went round to the left: {bearing}"
+    );
+    assert_eq!(holding(&world, 0), Some(ObstacleId(0)));
+}
+
+#[test]
+fn a_turret_in_speed_mode_turns_at_its_speed() {
+    let mut b = builder();
+    footbot(&mut b, 0.0, 0.0, 0.0);
+    let mut world = b.build();
+    let mut spin = command([0.0; 2], GripperAction::Hold);
+    spin.turret_mode = swarm_contract::messages::Turret::Speed;
+    spin.turret = 1.0;
+    for _ in 0..TPS {
+        step(&mut world, &[spin]);
+    }
+    let turret = world.arena.robots[0].gripper.turret;
+    assert!(
+        (turret - 1.0).abs() < 1e-4,
+        "one second at 1 rad/s: {turret}"
+    );
+}
+
+#[test]
+fn a_passive_turret_lets_the_robot_turn_under_its_held_object() {
+    let spun = |mode| {
+        let mut world = holding_a_cylinder_ahead();
+        let mut spin = command([-5.0, 5.0], GripperAction::Pick);
+        spin.turret_mode = mode;
+        for _ in 0..20 {
+            step(&mut world, &[spin]);
+        }
+        (world.arena.robots[0].heading, bearing_of_object(&world))
+    };
+    use swarm_contract::messages::Turret;
+    let (heading, bearing) = spun(Turret::Position);
+    assert!(heading > 0.5, "the robot turned: {heading}");
+    assert!(
+        (bearing - heading).abs() < 0.1,
+        "a held turret swings the object round with the robot: {bearing} vs {heading}"
+    );
+    let (heading, bearing) = spun(Turret::Passive);
+    assert!(heading > 0.5, "the robot turned: {heading}");
+    assert!(
+        bearing.abs() < heading / 2.0,
+        "a passive turret leaves the object behind: {bearing} vs {heading}"
     );
 }
