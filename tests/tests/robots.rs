@@ -491,3 +491,91 @@ fn runs_of_every_kind_are_a_pure_function_of_configuration_and_seed() {
         }
     }
 }
+
+/// A foot-bot before a wall, under a light, on a half-black floor, and a disc robot before another wall, each
+/// showing three of its readings on its LEDs (`sensor_probe`).
+const PROBES: &str = r#"<?xml version="1.0" ?>
+<argos-configuration>
+  <framework>
+    <experiment length="1" ticks_per_second="10" random_seed="3" />
+  </framework>
+  <controllers>
+    <sensor_probe id="footbot_probe" library="native">
+      <actuators><differential_steering implementation="default" /><leds implementation="default" medium="leds" /></actuators>
+      <sensors>
+        <footbot_proximity implementation="default" />
+        <footbot_light implementation="rot_z_only" />
+        <footbot_motor_ground implementation="rot_z_only" />
+      </sensors>
+      <params red="proximity:0" green="light:5" blue="ground:1" />
+    </sensor_probe>
+    <sensor_probe id="disc_probe" library="native">
+      <actuators><differential_steering implementation="default" /><leds implementation="default" medium="leds" /></actuators>
+      <sensors><range_finder implementation="default" rays="20" range="1.0" /></sensors>
+      <params red="range:0" green="range:5" blue="range:1" />
+    </sensor_probe>
+  </controllers>
+  <arena size="4,4,1" center="0,0,0.5">
+    <floor id="floor" source="regions" pixels_per_meter="50">
+      <region min="0,0" max="2,2" color="black" />
+    </floor>
+    <foot-bot id="fb"><body position="0,0,0" orientation="0,0,0" /><controller config="footbot_probe" /></foot-bot>
+    <box id="wall_fb" size="0.1,0.6,0.5" movable="false"><body position="FB_WALL_X,0,0" orientation="0,0,0" /></box>
+    <light id="light" position="0,1,0.5" orientation="0,0,0" color="yellow" intensity="3" medium="leds" />
+    <disc-robot id="disc"><body position="-1,-1,0" orientation="0,0,0" /><controller config="disc_probe" /></disc-robot>
+    <box id="wall_disc" size="0.1,0.4,0.5" movable="false"><body position="-0.55,-1,0" orientation="0,0,0" /></box>
+  </arena>
+  <physics_engines><dynamics2d id="dyn2d" /></physics_engines>
+  <media><led id="leds" /></media>
+</argos-configuration>
+"#;
+
+#[test]
+fn footbot_and_range_finder_readings_reach_the_controllers_as_geometry_says() {
+    // The foot-bot's wall face is 3 cm ahead of its body; the disc robot's 0.4 m ahead of its centre.
+    let r = f64::from(swarm_contract::bodies::FOOTBOT.radius);
+    let config = PROBES.replace("FB_WALL_X", &format!("{}", r + 0.03 + 0.05));
+    let dir = temp_dir();
+    let path = dir.path().join("probes.argos");
+    std::fs::write(&path, config).expect("write the configuration");
+    let out = temp_dir();
+    run_config(&path, out.path(), &["--ticks", "3"]);
+    let text = std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let led = |id: &str| -> [i64; 3] {
+        let row = text
+            .lines()
+            .find(|l| l.starts_with("2,") && l.contains(&format!(",{id},")))
+            .expect("the robot's row at tick 2");
+        let f: Vec<&str> = row.split(',').collect();
+        [6, 7, 8].map(|i| f[i].parse().expect("a colour channel"))
+    };
+    let level = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as i64;
+    // Foot-bot proximity sensor 0, 7.5 degrees left: its ray leaves the body edge and meets the face at x = r + 0.03.
+    let a = 7.5f64.to_radians();
+    let t = (r + 0.03 - r * a.cos()) / a.cos();
+    let proximity = 0.0100527 / (t + 0.000163144);
+    // Light sensor 5 at 82.5 degrees, 7.5 degrees off the light straight to the left, 1.118 m away (from the
+    // robot's origin on the ground), intensity 3.
+    let d = (1.0f64 + 0.25).sqrt();
+    let light = (-2.0 * d / 3.0).exp() * (1.0 - 2.0 * 7.5 / 180.0);
+    // Motor-ground sensor 1 at (-0.063, 0.0116): white floor (the black region starts at x = 0).
+    let expected_footbot = [level(proximity), level(light), 255];
+    let got = led("fb");
+    for (channel, (g, e)) in got.iter().zip(expected_footbot).enumerate() {
+        assert!(
+            (g - e).abs() <= 1,
+            "foot-bot channel {channel}: {got:?} vs {expected_footbot:?}"
+        );
+    }
+    // Disc range finder: ray 0 meets the wall 0.4 m ahead; ray 1 (18 degrees) meets it 0.4 / cos 18 m away, 0.13 m
+    // to the side, inside its 0.2 m half-width; ray 5 (90 degrees) meets nothing within its 1 m.
+    let ray1 = 0.4 / 18f64.to_radians().cos();
+    let expected_disc = [level(0.4), 255, level(ray1)];
+    let got = led("disc");
+    for (channel, (g, e)) in got.iter().zip(expected_disc).enumerate() {
+        assert!(
+            (g - e).abs() <= 1,
+            "disc channel {channel}: {got:?} vs {expected_disc:?}"
+        );
+    }
+}

@@ -9,6 +9,7 @@ pub mod footbot_flocking;
 pub mod footbot_foraging;
 pub mod footbot_gripping;
 pub mod footbot_synchronization;
+pub mod sensor_probe;
 
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
@@ -21,6 +22,7 @@ use footbot_flocking::FootbotFlocking;
 use footbot_foraging::FootbotForaging;
 use footbot_gripping::FootbotGripping;
 use footbot_synchronization::FootbotSynchronization;
+use sensor_probe::SensorProbe;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
 pub trait NativeController: Send {
@@ -55,6 +57,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (DiscWander::NAME, |p| {
         Ok(Box::new(DiscWander::from_params(p)?))
+    }),
+    (SensorProbe::NAME, |p| {
+        Ok(Box::new(SensorProbe::from_params(p)?))
     }),
 ];
 
