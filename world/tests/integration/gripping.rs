@@ -133,12 +133,8 @@ fn nothing_out_of_reach_or_fixed_is_gripped() {
     assert_eq!((holding(&world, 0), holding(&world, 1)), (None, None));
 }
 
-/// A 0.3 m box of 1 kg at the origin, a foot-bot gripping it from the west facing east and one from the east
-/// facing west.
-fn two_robots_and_a_box() -> World {
-    let mut b = builder();
-    footbot(&mut b, -(0.15 + R + 0.005), 0.0, 0.0);
-    footbot(&mut b, 0.15 + R + 0.005, 0.0, std::f32::consts::PI);
+/// A movable 0.3 m box of `mass` kg at the origin.
+fn box_at_origin(b: &mut swarm_world::WorldBuilder, mass: f32) -> ObstacleId {
     b.obstacle(
         "box",
         Placed::new(
@@ -149,8 +145,17 @@ fn two_robots_and_a_box() -> World {
             0.0,
         ),
         0.2,
-        Motion::Movable { mass: 1.0 },
-    );
+        Motion::Movable { mass },
+    )
+}
+
+/// A 0.3 m box of 1 kg at the origin, a foot-bot gripping it from the west facing east and one from the east
+/// facing west.
+fn two_robots_and_a_box() -> World {
+    let mut b = builder();
+    footbot(&mut b, -(0.15 + R + 0.005), 0.0, 0.0);
+    footbot(&mut b, 0.15 + R + 0.005, 0.0, std::f32::consts::PI);
+    box_at_origin(&mut b, 1.0);
     let mut world = b.build();
     let lock = command([0.0; 2], GripperAction::Pick);
     let events = step(&mut world, &[lock, lock]);
@@ -311,18 +316,7 @@ fn two_robots_and_a_heavy_box(lift_by: Option<u32>) -> World {
     let mut b = builder();
     footbot(&mut b, -(0.15 + R + 0.005), 0.1, 0.0);
     footbot(&mut b, -(0.15 + R + 0.005), -0.1, 0.0);
-    let the_box = b.obstacle(
-        "box",
-        Placed::new(
-            Shape::Rect {
-                half: Vec2::splat(0.15),
-            },
-            Vec2::ZERO,
-            0.0,
-        ),
-        0.2,
-        Motion::Movable { mass: 20.0 },
-    );
+    let the_box = box_at_origin(&mut b, 20.0);
     if let Some(n) = lift_by {
         b.lift_by(the_box, n);
     }
