@@ -410,6 +410,9 @@ fn add_entity(
                 }
                 rab.data_size = size as u8;
             }
+            if let (Some(rf), Some(range)) = (devices.range_finder.as_mut(), e.range_finder_range) {
+                rf.range = range as f32;
+            }
             let id = b.robot_with_body(e.body(), &e.id, &e.controller, position, yaw, devices);
             if let Some(range) = e.rab_range {
                 b.rab_range(id, range as f32);

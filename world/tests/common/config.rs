@@ -87,6 +87,7 @@ pub fn epuck(id: &str, line: u32) -> Entity {
         rab_range: None,
         rab_data_size: None,
         camera_aperture_deg: None,
+        range_finder_range: None,
         shape: DiscShape::default(),
         location: at(line),
     })

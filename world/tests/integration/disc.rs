@@ -150,6 +150,15 @@ fn disc_robots_come_from_the_configuration_with_their_own_bodies() {
         .range_finder
         .expect("the controller declares it");
     assert_eq!((rf.rays, rf.range), (20, 1.0));
+    let hauler_rf = robots[7]
+        .devices
+        .range_finder
+        .expect("the controller declares it");
+    assert_eq!(
+        (hauler_rf.rays, hauler_rf.range),
+        (20, 0.6),
+        "a hauler's own range_finder_range replaces its controller's range"
+    );
 }
 
 #[test]

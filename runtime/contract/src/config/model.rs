@@ -620,7 +620,7 @@ pub struct Led {
 
 /// `<e-puck id [rab_range] [rab_data_size]>`, `<foot-bot id [rab_range] [rab_data_size]
 /// [omnidirectional_camera_aperture]>` or `<disc-robot id [rab_range] [rab_data_size] [radius] [height] [mass]
-/// [wheel_base] [max_speed] [max_turn_rate]>`, with `<controller config>`.
+/// [wheel_base] [max_speed] [max_turn_rate]>`, each also `[range_finder_range]`, with `<controller config>`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotEntity {
     /// Which robot the element places.
@@ -635,6 +635,8 @@ pub struct RobotEntity {
     pub rab_data_size: Option<u32>,
     /// `omnidirectional_camera_aperture` in degrees (foot-bot), if given.
     pub camera_aperture_deg: Option<f64>,
+    /// `range_finder_range` (ours): this robot's range-finder reach in metres, replacing its controller's.
+    pub range_finder_range: Option<f64>,
     /// The disc robot's body attributes (all `None` for the e-puck and the foot-bot, whose bodies are fixed).
     pub shape: DiscShape,
     /// Where the element is.

@@ -408,7 +408,7 @@ const DISC_ATTRIBUTES: &[(&str, f64)] = &[
 fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let kind = RobotKind::from_tag(&el.name)?;
     let body = kind.body();
-    let mut known = vec!["id", "rab_range", "rab_data_size"];
+    let mut known = vec!["id", "rab_range", "rab_data_size", "range_finder_range"];
     let mut shape = DiscShape::default();
     let mut shape_ok = true;
     if kind == RobotKind::Disc {
@@ -451,6 +451,11 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         let max = f64::from(body.rab_data_size);
         ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(max))
     });
+    let range_finder_range: Option<f64> = ctx.attr(el, "range_finder_range");
+    let range_finder_ok = range_finder_range.is_none_or(|r| {
+        ctx.positive(el, "range_finder_range").is_some()
+            && ctx.in_range(el, "range_finder_range", r, 0.0, Some(100.0))
+    });
     let camera_aperture_deg: Option<f64> = ctx.attr(el, "omnidirectional_camera_aperture");
     let aperture_ok = camera_aperture_deg
         .is_none_or(|a| ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0)));
@@ -476,7 +481,8 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
             None
         }
     };
-    (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok).then_some(())?;
+    (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok && range_finder_ok)
+        .then_some(())?;
     Some(RobotEntity {
         kind,
         id: id?,
@@ -484,6 +490,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         rab_range,
         rab_data_size,
         camera_aperture_deg,
+        range_finder_range,
         shape,
         location: el.location,
     })
