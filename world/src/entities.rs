@@ -4,7 +4,7 @@
 //! that leave the arena change state instead of disappearing, so handles stay valid for the whole run). Systems
 //! (sensors, actuators, media, loop functions) are functions over these sets; no entity points at another.
 
-use swarm_contract::bodies::{BodyModel, CameraView, EPUCK};
+use swarm_contract::bodies::{BodyModel, EPUCK};
 use swarm_contract::messages::Rgb;
 
 use crate::devices::Devices;
@@ -54,10 +54,9 @@ handle!(
 pub struct Robot {
     /// The id from the configuration (`fb0`, `ep12`, ...).
     pub name: String,
-    /// Its body: shape, wheels and sensor placement.
+    /// Its body: shape, wheels and sensor placement (with the configuration's changes: a disc robot's
+    /// attributes, a foot-bot's camera aperture).
     pub body: BodyModel,
-    /// What its camera sees (the body's, unless the configuration sets another aperture).
-    pub camera_view: CameraView,
     /// The controller id the configuration assigns.
     pub controller: String,
     /// Physics handles.

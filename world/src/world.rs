@@ -118,7 +118,6 @@ impl WorldBuilder {
         self.arena.robots.push(Robot {
             name: name.to_owned(),
             body,
-            camera_view: body.camera_view,
             controller: controller.to_owned(),
             handles,
             position,
@@ -144,7 +143,7 @@ impl WorldBuilder {
     /// `omnidirectional_camera_aperture`).
     pub fn camera_aperture(&mut self, robot: RobotId, aperture: f32) {
         if let Some(r) = self.arena.robots.get_mut(robot.index()) {
-            r.camera_view = CameraView::Aperture(aperture);
+            r.body.camera_view = CameraView::Aperture(aperture);
         }
     }
 
@@ -491,7 +490,6 @@ impl World {
                     &self.scene,
                     &self.leds,
                     observer,
-                    robot.camera_view,
                     opts,
                     &mut robot.rng.camera,
                     frame,

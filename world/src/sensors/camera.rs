@@ -5,7 +5,6 @@
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use swarm_contract::bodies::CameraView;
 use swarm_contract::messages::{CameraBlob, SensorFrame};
 
 use crate::devices::CameraOptions;
@@ -18,12 +17,11 @@ use crate::sensors::insert_nearest;
 /// Side of the LED medium's grid cells in metres: the e-puck camera's range, so its query touches at most four.
 pub const LED_CELL: f32 = 0.35;
 
-/// Fills the camera part of `frame` for robot `me`, whose camera sees `view`.
+/// Fills the camera part of `frame` for robot `me`.
 pub fn sense(
     scene: &Scene,
     leds: &LedMedium,
     observer: Observer,
-    view: CameraView,
     options: &CameraOptions,
     rng: &mut ChaCha8Rng,
     frame: &mut SensorFrame,
@@ -34,10 +32,6 @@ pub fn sense(
         heading,
         body,
     } = observer;
-    let body = swarm_contract::bodies::BodyModel {
-        camera_view: view,
-        ..*body
-    };
     let camera_height = body.camera_height;
     let mut len = 0usize;
     let noise = (options.noise_std_dev > 0.0)

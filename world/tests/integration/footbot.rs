@@ -166,3 +166,23 @@ fn footbot_range_and_bearing_reports_centre_to_centre_range() {
     assert!((got[0].range_cm - 100.0).abs() < 0.1, "{}", got[0].range_cm);
     assert!((got[0].bearing - std::f32::consts::FRAC_PI_2).abs() < 1e-3);
 }
+
+#[test]
+fn a_wider_camera_aperture_sees_farther() {
+    // An LED ring 1 m away: beyond the default 70-degree cone (0.56 m), inside an 80-degree one (1.16 m).
+    let seen = |aperture_deg: Option<f32>| {
+        let mut b = builder();
+        footbot_at(&mut b, Vec2::ZERO, 0.0);
+        footbot_at(&mut b, Vec2::new(1.0, 0.0), 0.0);
+        if let Some(a) = aperture_deg {
+            b.camera_aperture(swarm_world::entities::RobotId(0), a.to_radians());
+        }
+        let mut world = b.build();
+        let mut lit = wheels(0.0, 0.0);
+        lit.led = Rgb { r: 0, g: 0, b: 255 };
+        drive(&mut world, 1, lit);
+        frames(&mut world)[0].camera_blobs().len()
+    };
+    assert_eq!(seen(None), 0);
+    assert_eq!(seen(Some(80.0)), 1);
+}
