@@ -116,6 +116,18 @@ impl Params {
             .collect()
     }
 
+    /// `name` as a whole number >= 0 that fits `T` (e.g. `u32`, `u64`), or `default` when absent.
+    pub fn whole_or<T: std::str::FromStr>(&self, name: &str, default: T) -> Result<T, ParamError> {
+        let Some(raw) = self.get(name) else {
+            return Ok(default);
+        };
+        raw.trim().parse::<T>().map_err(|_| ParamError::Malformed {
+            name: name.to_owned(),
+            value: raw.to_owned(),
+            expected: "a whole number >= 0",
+        })
+    }
+
     /// `name` as a finite `f32`, or `default` when absent.
     pub fn f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
         let Some(raw) = self.get(name) else {

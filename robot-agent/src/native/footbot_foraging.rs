@@ -116,18 +116,6 @@ fn degree_range(
     Ok((lo.to_radians(), hi.to_radians()))
 }
 
-fn whole(params: &Params, name: &str, default: u32) -> Result<u32, ParamError> {
-    let v = params.non_negative_f32_or(name, default as f32)?;
-    if v.fract() != 0.0 || v > u32::MAX as f32 {
-        return Err(ParamError::OutOfRange {
-            name: name.to_owned(),
-            value: params.get(name).unwrap_or_default().to_owned(),
-            rule: "must be a whole number of ticks",
-        });
-    }
-    Ok(v as u32)
-}
-
 impl FootbotForaging {
     /// Registry name.
     pub const NAME: &'static str = "footbot_foraging";
@@ -143,17 +131,11 @@ impl FootbotForaging {
             collision_explore_to_rest_delta: p("collision_rule_explore_to_rest_delta_prob", 0.01)?,
             social_rest_to_explore_delta: p("social_rule_rest_to_explore_delta_prob", 0.01)?,
             social_explore_to_rest_delta: p("social_rule_explore_to_rest_delta_prob", 0.01)?,
-            minimum_resting_time: whole(params, "state.minimum_resting_time", 50)?,
-            minimum_unsuccessful_explore_time: whole(
-                params,
-                "state.minimum_unsuccessful_explore_time",
-                600,
-            )?,
-            minimum_search_for_place_in_nest_time: whole(
-                params,
-                "state.minimum_search_for_place_in_nest_time",
-                50,
-            )?,
+            minimum_resting_time: params.whole_or("state.minimum_resting_time", 50)?,
+            minimum_unsuccessful_explore_time: params
+                .whole_or("state.minimum_unsuccessful_explore_time", 600)?,
+            minimum_search_for_place_in_nest_time: params
+                .whole_or("state.minimum_search_for_place_in_nest_time", 50)?,
         };
         Ok(Self {
             go_straight: degree_range(params, "diffusion.go_straight_angle_range", (-10.0, 10.0))?,

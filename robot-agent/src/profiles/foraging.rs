@@ -116,8 +116,8 @@ impl Forager {
             food_color: color_or(params, "food_color", Rgb { r: 255, g: 0, b: 0 })?,
             food_reach_cm: params.non_negative_f32_or("food_reach_cm", DEFAULT_FOOD_REACH_CM)?,
             resting: bool_or(params, "resting", true)?,
-            search_budget: u64_or(params, "search_budget_steps", DEFAULT_SEARCH_BUDGET)?,
-            rest_ticks: u64_or(params, "rest_ticks", DEFAULT_REST_TICKS)?,
+            search_budget: params.whole_or("search_budget_steps", DEFAULT_SEARCH_BUDGET)?,
+            rest_ticks: params.whole_or("rest_ticks", DEFAULT_REST_TICKS)?,
             phase: Phase::Idle,
             phase_started: 0,
             pick_requested: None,
@@ -183,16 +183,6 @@ fn bool_or(params: &Params, name: &str, default: bool) -> Result<bool, ParamErro
         Some("true") => Ok(true),
         Some("false") => Ok(false),
         Some(other) => Err(malformed(name, other, "`true` or `false`")),
-    }
-}
-
-fn u64_or(params: &Params, name: &str, default: u64) -> Result<u64, ParamError> {
-    match params.get(name) {
-        None => Ok(default),
-        Some(raw) => raw
-            .trim()
-            .parse()
-            .map_err(|_| malformed(name, raw, "a whole number >= 0")),
     }
 }
 

@@ -65,7 +65,7 @@ impl Firefly {
     /// Reads `top` (whole, 1 to 2^32 - 1), `alpha` (in [0, 1]), `refractory` (whole ticks) and `phase_seed`
     /// (whole; default the run's seed).
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
-        let top = whole_or(params, "top", DEFAULT_TOP)?;
+        let top = params.whole_or("top", DEFAULT_TOP)?;
         if top == 0 {
             return Err(ParamError::OutOfRange {
                 name: "top".to_owned(),
@@ -76,8 +76,8 @@ impl Firefly {
         Ok(Self {
             top,
             alpha: params.unit_f32_or("alpha", DEFAULT_ALPHA)?,
-            refractory: whole_or(params, "refractory", DEFAULT_REFRACTORY)?,
-            phase_seed: whole_or(params, "phase_seed", params.run_seed())?,
+            refractory: params.whole_or("refractory", DEFAULT_REFRACTORY)?,
+            phase_seed: params.whole_or("phase_seed", params.run_seed())?,
             counter: None,
             last_sync: None,
         })
@@ -88,22 +88,6 @@ impl Firefly {
         self.counter
             .unwrap_or_else(|| initial_counter(self.phase_seed, frame.robot, self.top))
     }
-}
-
-/// A parameter that must be a whole number that fits `T`, or `default` when absent.
-fn whole_or<T: std::str::FromStr>(
-    params: &Params,
-    name: &str,
-    default: T,
-) -> Result<T, ParamError> {
-    let Some(raw) = params.get(name) else {
-        return Ok(default);
-    };
-    raw.trim().parse::<T>().map_err(|_| ParamError::Malformed {
-        name: name.to_owned(),
-        value: raw.to_owned(),
-        expected: "a whole number >= 0",
-    })
 }
 
 /// The initial counter of `robot`: uniform in [1, top], a pure function of (`seed`, `robot`) (SplitMix64's
