@@ -4,17 +4,12 @@
 
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use std::f32::consts::TAU;
 use swarm_contract::bodies::BodyModel;
-
-use swarm_contract::messages::{
-    ActuatorCommand, Drive, GripperAction, PHEROMONE_CHANNELS, Scanner,
-};
+use swarm_contract::messages::{ActuatorCommand, Drive, GripperAction, PHEROMONE_CHANNELS};
 
 use crate::arena::{Arena, GripperEvent};
 use crate::entities::{RobotId, TargetId, TargetState};
 use crate::geometry::unit;
-use crate::gripper::GripperState;
 use crate::media::rab::RabMedium;
 
 /// Default largest edge-to-edge gap in metres at which the virtual gripper reaches a target (the thesis' 7 mm);
@@ -83,15 +78,11 @@ pub fn apply(
         arena.physics.drive(robot.handles.body, 0.0, 0.0);
         return;
     };
-    let commanded = match cmd.drive {
-        Drive::Wheels => cmd.wheels,
-        Drive::Twist => twist_to_wheels(cmd.twist, &robot.body),
-    };
     // A twist within the limits may ask one wheel for more than the wheel limit (full speed while turning):
     // the turn-rate limit, not the wheel limit, bounds it, as on a TurtleBot.
-    let max_wheel = match cmd.drive {
-        Drive::Wheels => robot.body.max_wheel_speed_cm_s,
-        Drive::Twist => f32::INFINITY,
+    let (commanded, max_wheel) = match cmd.drive {
+        Drive::Wheels => (cmd.wheels, robot.body.max_wheel_speed_cm_s),
+        Drive::Twist => (twist_to_wheels(cmd.twist, &robot.body), f32::INFINITY),
     };
     robot.wheels = wheel_speeds(
         commanded,
@@ -119,17 +110,8 @@ pub fn apply(
             .pheromone
             .deposit(ch, position, cmd.pheromone_deposit[ch]);
     }
-    robot.scanner.mode = cmd.scanner;
-    if cmd.scanner_setting.is_finite() {
-        match cmd.scanner {
-            Scanner::Off => {}
-            Scanner::Angle => robot.scanner.rotation = cmd.scanner_setting.rem_euclid(TAU),
-            Scanner::Speed => {
-                robot.scanner.speed = cmd.scanner_setting * TAU / 60.0;
-                robot.scanner.rotation =
-                    (robot.scanner.rotation + robot.scanner.speed * dt).rem_euclid(TAU);
-            }
-        }
+    if robot.devices.distance_scanner {
+        robot.scanner.command(cmd.scanner, cmd.scanner_setting, dt);
     }
     if robot.devices.gripper.is_some() {
         let gripper = &mut robot.gripper;
@@ -137,11 +119,8 @@ pub fn apply(
             GripperAction::Hold => {}
             GripperAction::Pick => gripper.locked = true,
             GripperAction::Drop => {
-                *gripper = GripperState {
-                    locked: false,
-                    lost: false,
-                    ..*gripper
-                }
+                gripper.locked = false;
+                gripper.lost = false;
             }
         }
         crate::gripper::command_turret(arena, id, cmd.turret_mode, cmd.turret, dt);

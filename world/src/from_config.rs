@@ -3,13 +3,14 @@
 //!
 //! Mapping of entities: `<box>` and `<cylinder>` are obstacles (walls are simply boxes), unless they carry
 //! `<leds>`, in which case they are targets (ARGoS' passive objects with an LED; one LED each); `<target>` is a
-//! target; `<e-puck>` and `<foot-bot>` robots; `<light>` a light. Every failure is a [`WorldError`] naming `file:line:column`.
+//! target; `<e-puck>`, `<foot-bot>` and `<disc-robot>` robots; `<light>` a light. Every failure is a
+//! [`WorldError`] naming `file:line:column`.
 
 use swarm_contract::bodies::RobotKind;
 use swarm_contract::config::{
     self, Controller, Device, DeviceKind, Entity, Experiment, FloorSource, Location, PlacedEntity,
 };
-use swarm_contract::messages::{MAX_RANGE_RAYS, PHEROMONE_CHANNELS, Rgb};
+use swarm_contract::messages::{MAX_RANGE_FINDER_RANGE, MAX_RANGE_RAYS, PHEROMONE_CHANNELS, Rgb};
 
 use crate::actuators::GRIPPER_REACH;
 use crate::devices::{
@@ -46,8 +47,6 @@ fn invalid(exp: &Experiment, location: Location, message: impl Into<String>) -> 
 pub const DEFAULT_RANGE_RAYS: usize = 20;
 /// Reach in metres of a `range_finder` that does not say.
 pub const DEFAULT_RANGE_FINDER_RANGE: f64 = 1.0;
-/// Longest range-finder reach accepted, in metres.
-pub const MAX_RANGE_FINDER_RANGE: f64 = 100.0;
 
 /// ITU-R 601 luma of a colour as a grey level in [0, 1] (what ARGoS' ground sensors read).
 pub fn grey_level(c: Rgb) -> f32 {

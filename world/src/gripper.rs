@@ -109,8 +109,8 @@ pub fn update(arena: &mut Arena) {
         let Some(options) = r.devices.gripper else {
             continue;
         };
+        // A robot that dies lets go at once (`World::set_alive`), so a holder here is alive.
         match r.gripper.holding {
-            Some(_) if !r.alive => release(arena, id, ReleaseCause::Died),
             Some(_) if !r.gripper.locked => release(arena, id, ReleaseCause::Opened),
             Some(_) if load(arena, id) > options.max_force => {
                 release(arena, id, ReleaseCause::Overloaded);
@@ -145,18 +145,18 @@ fn lift_or_lower(arena: &mut Arena) {
         let damping = if lifted { 0.0 } else { MOVABLE_DAMPING };
         arena.physics.set_damping(o.handles.body, damping);
         // Reported for every robot that holds it now and, when it comes down, every robot that let go of it in
-        // this update (robot order); the events only grow, so the earlier ones are read from a copy of the count.
-        let released_now = arena.gripper_events.len();
-        for i in 0..released_now {
-            if let GripperEvent::Released {
-                robot, obstacle: o, ..
-            } = arena.gripper_events[i]
-                && o == obstacle
-                && !lifted
-            {
-                arena
-                    .gripper_events
-                    .push(GripperEvent::Lowered { robot, obstacle });
+        // this tick (robot order); the events only grow, so the earlier ones are read up to their count now.
+        if !lifted {
+            for i in 0..arena.gripper_events.len() {
+                if let GripperEvent::Released {
+                    robot, obstacle: o, ..
+                } = arena.gripper_events[i]
+                    && o == obstacle
+                {
+                    arena
+                        .gripper_events
+                        .push(GripperEvent::Lowered { robot, obstacle });
+                }
             }
         }
         for &robot in arena.gripping_robots.iter().filter(holding) {

@@ -203,13 +203,7 @@ impl Physics {
         body2: RigidBodyHandle,
         at: Vec2,
     ) -> Option<ImpulseJointHandle> {
-        let local = |h: RigidBodyHandle| {
-            self.world
-                .bodies
-                .get(h)
-                .map(|b| b.position().inverse_transform_point(at))
-        };
-        let (anchor1, anchor2) = (local(body1)?, local(body2)?);
+        let (anchor1, anchor2) = (self.local_point(body1, at)?, self.local_point(body2, at)?);
         let joint = RevoluteJointBuilder::new()
             .local_anchor1(anchor1)
             .local_anchor2(anchor2)
@@ -259,7 +253,7 @@ impl Physics {
         Some(b.position().inverse_transform_point(at))
     }
 
-    /// Removes a joint made by [`Physics::pin`].
+    /// Removes a joint made by [`Physics::pin`] or [`Physics::weld`].
     pub fn unpin(&mut self, joint: ImpulseJointHandle) {
         self.world.impulse_joints.remove(joint, true);
     }

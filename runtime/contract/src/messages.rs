@@ -27,6 +27,8 @@ pub const MAX_LIGHT_SENSORS: usize = 24;
 pub const MAX_GROUND_SENSORS: usize = 4;
 /// Most rays of a range-finder ring (paper A's robots use 20, 18 degrees apart).
 pub const MAX_RANGE_RAYS: usize = 24;
+/// Longest range-finder reach a configuration may give, in metres (`<range_finder range>`, `range_finder_range`).
+pub const MAX_RANGE_FINDER_RANGE: f64 = 100.0;
 /// Most LED blobs the omnidirectional camera reports per tick; further blobs (farthest first) are dropped.
 pub const MAX_CAMERA_BLOBS: usize = 16;
 /// Most range-and-bearing messages a robot receives per tick; further messages (farthest first) are dropped.

@@ -53,10 +53,7 @@ impl LoopOutput {
         };
         self.file.write_all(&self.buffer).map_err(io)?;
         self.buffer.clear();
-        self.file.flush().map_err(|source| WorldError::Io {
-            path: self.path.clone(),
-            source,
-        })
+        self.file.flush().map_err(io)
     }
 }
 
@@ -117,9 +114,10 @@ impl Recorder {
         }));
     }
 
-    /// Ends the world's current tick: the physical grippers' events of the tick (`gripper:grip`,
-    /// `gripper:lifted`, `gripper:lowered`, `gripper:release`, `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded
-    /// since the last tick go to the writing thread, and a snapshot is drawn if this tick is scheduled.
+    /// Ends the world's current tick: the loop functions' output of the tick goes to its file; the physical
+    /// grippers' events of the tick (`gripper:grip`, `gripper:lifted`, `gripper:lowered`, `gripper:release`,
+    /// `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded since the last
+    /// tick go to the writing thread; and a snapshot is drawn if this tick is scheduled.
     pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
         if let Some(output) = &mut self.loop_output {
             output.write(world)?;

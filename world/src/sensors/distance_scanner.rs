@@ -9,7 +9,7 @@
 
 use std::f32::consts::{FRAC_PI_2, TAU};
 
-use swarm_contract::messages::SensorFrame;
+use swarm_contract::messages::{Scanner, SensorFrame};
 
 use crate::geometry::unit;
 use crate::scene::Scene;
@@ -30,13 +30,29 @@ pub const SAMPLES_WHILE_TURNING: usize = 6;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ScannerState {
     /// Off, held, or turning.
-    pub mode: swarm_contract::messages::Scanner,
+    pub mode: Scanner,
     /// Turret angle in radians from the heading, in [0, 2 pi).
     pub rotation: f32,
-    /// Turning speed in radians per second.
-    pub speed: f32,
     /// The turret angle when the scanner last read.
     pub last_read: f32,
+}
+
+impl ScannerState {
+    /// Applies the actuator's command for a tick of `dt` seconds: the mode, and the angle (`Angle`, radians) or
+    /// the speed (`Speed`, revolutions per minute) the turret turns at through the tick.
+    pub fn command(&mut self, mode: Scanner, setting: f32, dt: f32) {
+        self.mode = mode;
+        if !setting.is_finite() {
+            return;
+        }
+        match mode {
+            Scanner::Off => {}
+            Scanner::Angle => self.rotation = setting.rem_euclid(TAU),
+            Scanner::Speed => {
+                self.rotation = (self.rotation + setting * TAU / 60.0 * dt).rem_euclid(TAU);
+            }
+        }
+    }
 }
 
 /// Fills the scanner part of `frame` for robot `me`, whose scanner is in `state`; `scratch` receives the gathered
@@ -48,7 +64,6 @@ pub fn sense(
     scratch: &mut Vec<u32>,
     frame: &mut SensorFrame,
 ) {
-    use swarm_contract::messages::Scanner;
     let Observer {
         me,
         position,

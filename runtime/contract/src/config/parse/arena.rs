@@ -10,7 +10,7 @@ use crate::config::model::{
 };
 use crate::config::registry::MediumKind;
 use crate::config::suggest::did_you_mean;
-use crate::messages::Rgb;
+use crate::messages::{MAX_RANGE_FINDER_RANGE, Rgb};
 
 const ENTITIES: &[&str] = &[
     "box",
@@ -403,6 +403,17 @@ const DISC_ATTRIBUTES: &[(&str, f64)] = &[
     ("max_turn_rate", 1_000.0),
 ];
 
+/// An optional attribute that must be above 0 and at most `max`: `Some(None)` when absent, `None` when it is bad
+/// (reported).
+fn positive_at_most(ctx: &mut Ctx, el: &Element, name: &str, max: f64) -> Option<Option<f64>> {
+    if !el.attributes.contains_key(name) {
+        return Some(None);
+    }
+    let value = ctx.positive(el, name)?;
+    ctx.in_range(el, name, value, 0.0, Some(max))
+        .then_some(Some(value))
+}
+
 /// `<e-puck>`, `<foot-bot>` or `<disc-robot>`: id, range-and-bearing options, the foot-bot's camera aperture, the
 /// disc robot's body, `<controller>`.
 fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
@@ -421,11 +432,9 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
             &mut shape.max_speed,
             &mut shape.max_turn_rate,
         ]) {
-            if el.attributes.contains_key(name) {
-                *field = ctx
-                    .positive(el, name)
-                    .filter(|&v| ctx.in_range(el, name, v, 0.0, Some(max)));
-                shape_ok &= field.is_some();
+            match positive_at_most(ctx, el, name, max) {
+                Some(value) => *field = value,
+                None => shape_ok = false,
             }
         }
     }
@@ -451,11 +460,9 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         let max = f64::from(body.rab_data_size);
         ctx.in_range(el, "rab_data_size", f64::from(d), 1.0, Some(max))
     });
-    let range_finder_range: Option<f64> = ctx.attr(el, "range_finder_range");
-    let range_finder_ok = range_finder_range.is_none_or(|r| {
-        ctx.positive(el, "range_finder_range").is_some()
-            && ctx.in_range(el, "range_finder_range", r, 0.0, Some(100.0))
-    });
+    let range_finder_range =
+        positive_at_most(ctx, el, "range_finder_range", MAX_RANGE_FINDER_RANGE);
+    let range_finder_ok = range_finder_range.is_some();
     let camera_aperture_deg: Option<f64> = ctx.attr(el, "omnidirectional_camera_aperture");
     let aperture_ok = camera_aperture_deg
         .is_none_or(|a| ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0)));
@@ -490,7 +497,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         rab_range,
         rab_data_size,
         camera_aperture_deg,
-        range_finder_range,
+        range_finder_range: range_finder_range.flatten(),
         shape,
         location: el.location,
     })
