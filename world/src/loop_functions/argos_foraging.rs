@@ -16,6 +16,8 @@
 //! appends `clock walking resting collected_food energy` to the `output` file, which is written in the run
 //! folder rather than the working folder, so that runs never overwrite each other's.
 
+use std::io::Write;
+
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use swarm_contract::messages::{ActuatorCommand, Rgb};
@@ -185,11 +187,12 @@ impl LoopFunctions for ArgosForaging {
         }
         self.energy -= walking as i64 * self.energy_per_walking_robot;
         (self.walking, self.resting) = (walking, resting);
-        let row = format!(
-            "{}\t{walking}\t{resting}\t{}\t{}\n",
+        // Writing into a Vec cannot fail.
+        let _ = writeln!(
+            self.output,
+            "{}\t{walking}\t{resting}\t{}\t{}",
             arena.tick, self.collected, self.energy
         );
-        self.output.extend_from_slice(row.as_bytes());
     }
 
     fn floor_color(&self, p: Vec2) -> Option<f32> {
