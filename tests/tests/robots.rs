@@ -23,15 +23,19 @@ fn summary(out: &Path) -> serde_json::Value {
 /// Runs an ARGoS example from a folder that is not the workspace, as a user who keeps configs elsewhere does.
 fn run_example_elsewhere(example: &str, out: &Path, extra: &[&str]) {
     let config = workspace_file(&format!("configs/argos_examples/{example}"));
-    let elsewhere = temp_dir();
+    run_in(temp_dir().path(), &config, out, extra);
+}
+
+/// Runs `config` to completion into `out` from the folder `cwd`; the run must succeed and leave nothing behind.
+fn run_in(cwd: &Path, config: &Path, out: &Path, extra: &[&str]) {
     let config = config.display().to_string();
     let out_arg = out.display().to_string();
     let mut args = vec!["run", &config, "--out", &out_arg, "--no-progress"];
     args.extend_from_slice(extra);
-    let outcome = swarm_in(elsewhere.path(), &args);
+    let outcome = swarm_in(cwd, &args);
     assert!(
         outcome.output.status.success(),
-        "swarm run {example} failed:\n{}",
+        "swarm run {config} failed:\n{}",
         outcome.stderr()
     );
     assert_clean(&outcome);
@@ -149,18 +153,7 @@ fn a_footbot_example_without_a_length_runs_until_interrupted() {
 
 /// Runs `config` (a workspace path) to completion into `out` from the workspace root.
 fn run_config(config: &Path, out: &Path, extra: &[&str]) {
-    let workspace = swarm_system_tests::workspace_root();
-    let config = config.display().to_string();
-    let out_arg = out.display().to_string();
-    let mut args = vec!["run", &config, "--out", &out_arg, "--no-progress"];
-    args.extend_from_slice(extra);
-    let outcome = swarm_in(&workspace, &args);
-    assert!(
-        outcome.output.status.success(),
-        "swarm run {config} failed:\n{}",
-        outcome.stderr()
-    );
-    assert_clean(&outcome);
+    run_in(&swarm_system_tests::workspace_root(), config, out, extra);
 }
 
 #[test]
