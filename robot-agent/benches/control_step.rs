@@ -8,6 +8,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use robot_agent::control::{self, Control};
 use robot_agent::controller::{self, Plan};
 use robot_agent::params::Params;
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 fn frames() -> [SensorFrame; 2] {
@@ -23,13 +24,15 @@ fn bench_element(c: &mut Criterion, label: &str, element: &str) {
     let mut control: Control = control::build(&plan, &params, 124, 0).unwrap();
     let frames = frames();
     let mut command = ActuatorCommand::idle(0, 0);
+    let inbox = Mailbox::empty(0);
+    let mut outbox = Mailbox::empty(0);
     let mut tick = 0usize;
     c.bench_function(label, |b| {
         b.iter(|| {
             tick += 1;
             // An obstacle every 8th tick, as a robot in a sparse arena sees one now and then.
             let frame = &frames[usize::from(tick.is_multiple_of(8))];
-            control.step(black_box(frame), &mut command);
+            control.step(black_box(frame), &inbox, &mut outbox, &mut command);
             black_box(&command);
         })
     });

@@ -4,6 +4,7 @@
 //! the profile's callbacks (one error listing all mismatches), or builds the native controller. Every failure here
 //! happens at startup, so the agent can exit non-zero with the reason before tick 1.
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::player::{Player, PlayerError};
 use swarm_contract::supervisor_gen::compiled::SupervisorSet;
@@ -67,15 +68,22 @@ impl Control {
         }
     }
 
-    /// One control step: the player's step with the bound callbacks, or the native controller's step. `command`
+    /// One control step: the player's step with the bound callbacks, or the native controller's step with the
+    /// tick's `inbox` and an `outbox` for what it sends (supervised controllers do not talk yet). `command`
     /// carries the actuator state over from the previous tick; allocates nothing.
     #[unsafe(link_section = "swarm_hot")]
-    pub fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand) {
+    pub fn step(
+        &mut self,
+        frame: &SensorFrame,
+        inbox: &Mailbox,
+        outbox: &mut Mailbox,
+        command: &mut ActuatorCommand,
+    ) {
         match self {
             Control::Supervised { player, callbacks } => player.step(frame, callbacks, command),
             Control::Native(native) => {
                 command.events_len = 0;
-                native.step(frame, command);
+                native.step_with_mail(frame, inbox, outbox, command);
             }
         }
     }

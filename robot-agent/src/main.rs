@@ -19,6 +19,7 @@ use robot_agent::params::Params;
 use robot_agent::resume::Resumer;
 use swarm_contract::config::Experiment;
 use swarm_contract::limits::Limits;
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::protocol::launcher_to_agent::AgentArgs;
 use swarm_contract::protocol::resume::ResumePoint;
@@ -192,17 +193,20 @@ fn tick_loop(
 ) -> Result<()> {
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
     let mut command = ActuatorCommand::idle(robot, 0);
-    while let Some(tick) = link.next_tick().context("waiting for a tick")? {
+    let mut outbox = Mailbox::empty(robot);
+    while let Some(mut tick) = link.next_tick().context("waiting for a tick")? {
         if STOP_REQUESTED.load(Ordering::Relaxed) {
             info!(robot, "asked to stop: leaving the run");
             return Ok(());
         }
-        if resumer.before_step(control, tick.frame())? {
-            control.step(tick.frame(), &mut command);
+        outbox.clear();
+        let (frame, inbox) = tick.frame_and_inbox();
+        if resumer.before_step(control, frame)? {
+            control.step(frame, inbox, &mut outbox, &mut command);
         } else {
             command.events_len = 0;
         }
-        tick.answer(&mut command);
+        tick.answer_with_mail(&mut command, &outbox);
     }
     info!(robot, "the world ended the run");
     Ok(())

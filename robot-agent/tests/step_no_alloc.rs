@@ -7,6 +7,7 @@ use robot_agent::control;
 use robot_agent::controller;
 use robot_agent::params::Params;
 use swarm_contract::alloc_count::{CountingAllocator, thread_allocations};
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 #[global_allocator]
@@ -20,10 +21,12 @@ fn allocations_in_1000_steps(element: &str) -> u64 {
     let mut obstacle = SensorFrame::empty(0);
     obstacle.proximity[7] = 0.6;
     let mut command = ActuatorCommand::idle(0, 0);
+    let inbox = Mailbox::empty(0);
+    let mut outbox = Mailbox::empty(0);
     let before = thread_allocations();
     for tick in 0..1000u64 {
         let frame = if tick % 7 == 0 { &obstacle } else { &clear };
-        control.step(frame, &mut command);
+        control.step(frame, &inbox, &mut outbox, &mut command);
     }
     thread_allocations() - before
 }

@@ -19,11 +19,14 @@ use rand::{Rng, SeedableRng};
 use swarm_cli::experiment::grid::Grid;
 use swarm_contract::config::Experiment;
 use swarm_contract::config::faults::FaultSchedule;
+use swarm_contract::mail::{Address, Mailbox};
 use swarm_contract::messages::{ActuatorCommand, SensorFrame, SupervisorSnapshot};
 use swarm_remote::auth::{HostKey, Seal};
 use swarm_remote::codec::{self, DEFAULT_MAX_PAYLOAD, Header, Kind};
-use swarm_remote::host_to_world::{AssignmentReply, OrderReply, Reply};
-use swarm_remote::world_to_host::{Assignment, Order, OrderAction, kill_payload, parse_kill};
+use swarm_remote::host_to_world::{AssignmentReply, OrderReply, Reply, ReplyEntry};
+use swarm_remote::world_to_host::{
+    Assignment, FrameEntry, Order, OrderAction, kill_payload, parse_kill,
+};
 use swarm_system_tests::workspace_file;
 
 /// Mutants per corpus entry unless `SWARM_FUZZ_MUTANTS` says otherwise.
@@ -329,6 +332,7 @@ fn network_corpus() -> Vec<(String, Vec<u8>)> {
         agent_exit_grace_ms: 500,
         pin_agents: true,
         realtime_priority: false,
+        mail: true,
         compiled_supervisors: vec![("oa".into(), vec![1, 2, 3])],
         limits: vec!["tick_deadline_ms=300".into()],
         resume: vec![(5, SupervisorSnapshot::default())],
@@ -343,20 +347,27 @@ fn network_corpus() -> Vec<(String, Vec<u8>)> {
             snapshot: Box::default(),
         },
     };
+    let mut mailbox = Mailbox::empty(2);
+    mailbox
+        .send(Address::Within(0.5), b"a message")
+        .expect("fits");
+    mailbox.send(Address::To(3), &[9; 40]).expect("fits");
+    let (frame_2, frame_3) = (SensorFrame::empty(2), SensorFrame::empty(3));
     let mut frames = Vec::new();
     codec::encode_batch(
         &mut frames,
         &Header::new(Kind::Frames, 0x1234, 1, 2, 17),
         &[2, 3],
-        &[SensorFrame::empty(2), SensorFrame::empty(3)],
+        [(&frame_2, Some(&mailbox)), (&frame_3, None)],
     )
     .expect("encodes");
+    let (answered, dead) = (Reply::Answered(ActuatorCommand::idle(2, 17)), Reply::Dead);
     let mut replies = Vec::new();
     codec::encode_batch(
         &mut replies,
         &Header::new(Kind::Replies, 0x1234, 1, 2, 17),
         &[2, 3],
-        &[Reply::Answered(ActuatorCommand::idle(2, 17)), Reply::Dead],
+        [(&answered, Some(&mailbox)), (&dead, None)],
     )
     .expect("encodes");
     vec![
@@ -394,8 +405,8 @@ fn network_corpus() -> Vec<(String, Vec<u8>)> {
 #[test]
 fn network_messages_decode_or_are_refused_and_no_altered_message_passes_its_tag() {
     let seal = Seal::Key(Arc::new(HostKey::from_secret(&[7; 32])));
-    let mut frames_out = vec![SensorFrame::empty(0); 2];
-    let mut replies_out = vec![Reply::Missing; 2];
+    let mut frames_out = vec![FrameEntry::empty(0); 2];
+    let mut replies_out = vec![ReplyEntry::MISSING; 2];
     let corpus = network_corpus();
     let mut originals: Vec<Vec<u8>> = Vec::new();
     for (_, bytes) in &corpus {

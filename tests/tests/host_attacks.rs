@@ -13,9 +13,9 @@ use std::time::{Duration, Instant};
 
 use swarm_remote::auth::{HostKey, Seal};
 use swarm_remote::codec::{self, Header, Kind};
-use swarm_remote::host_to_world::Reply;
+use swarm_remote::host_to_world::{Reply, without_outboxes};
 use swarm_remote::keys;
-use swarm_remote::world_to_host::{Order, OrderAction, kill_payload};
+use swarm_remote::world_to_host::{Order, OrderAction, kill_payload, without_inboxes};
 use swarm_system_tests::{
     HostDaemon, TestKeys, follow_lines, free_port, remove_run_leftovers, spawn_swarm, swarm_ctl,
 };
@@ -197,10 +197,10 @@ fn strangers_cannot_join_and_an_insider_cannot_command_another_host_or_stall_the
         &mut future,
         &Header::new(Kind::Frames, run_id, 1, 1, u64::MAX - 1),
         &[2, 3],
-        &[
+        without_inboxes(&[
             swarm_contract::messages::SensorFrame::empty(2),
             swarm_contract::messages::SensorFrame::empty(3),
-        ],
+        ]),
     )
     .expect("encodes");
     insider
@@ -222,7 +222,7 @@ fn strangers_cannot_join_and_an_insider_cannot_command_another_host_or_stall_the
             &mut forged,
             &Header::new(Kind::Replies, run_id, 1, 1, tick + ahead),
             &[2, 3],
-            &[command(2), command(3)],
+            without_outboxes(&[command(2), command(3)]),
         )
         .expect("encodes");
         insider

@@ -117,24 +117,16 @@ fn read(out: &Path, name: &str) -> Vec<u8> {
     std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-/// Runs the obstacle-avoidance experiment (10 robots, 150 ticks, seed 11, plus `extra` arguments) once on this
-/// machine and once on two hosts; checks the hosts shared the robots and the records are the same byte for byte.
-/// Returns both summaries (single host first) and the hosts, still running.
-fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value, Hosts) {
-    let mut common = vec![
-        "--robots",
-        "10",
-        "--ticks",
-        "150",
-        "--seed",
-        "11",
-        "--no-progress",
-    ];
-    common.extend(extra);
+/// Runs `config` with the arguments `common` once on this machine and once on two hosts, both to success and the
+/// second with nothing left behind; returns both run folders (single host first) and the hosts, still running.
+fn run_single_and_on_two_hosts(
+    config: &str,
+    common: &[&str],
+) -> (tempfile::TempDir, tempfile::TempDir, Hosts) {
     let single = tempfile::tempdir().expect("a temporary directory");
     let out = single.path().display().to_string();
-    let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
-    args.extend(&common);
+    let mut args = vec!["run", config, "--out", &out, "--no-progress"];
+    args.extend(common);
     let outcome = swarm(&args);
     assert!(
         outcome.output.status.success(),
@@ -146,8 +138,8 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
     let multi = tempfile::tempdir().expect("a temporary directory");
     let out = multi.path().display().to_string();
     let host_args = hosts.run_args();
-    let mut args = vec!["run", OBSTACLE_AVOIDANCE, "--out", &out];
-    args.extend(&common);
+    let mut args = vec!["run", config, "--out", &out, "--no-progress"];
+    args.extend(common);
     args.extend(host_args.iter().map(String::as_str));
     let outcome = swarm(&args);
     assert!(
@@ -165,7 +157,16 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
             daemon.log()
         );
     }
+    (single, multi, hosts)
+}
 
+/// Runs the obstacle-avoidance experiment (10 robots, 150 ticks, seed 11, plus `extra` arguments) once on this
+/// machine and once on two hosts; checks the hosts shared the robots and the records are the same byte for byte.
+/// Returns both summaries (single host first) and the hosts, still running.
+fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value, Hosts) {
+    let mut common = vec!["--robots", "10", "--ticks", "150", "--seed", "11"];
+    common.extend(extra);
+    let (single, multi, hosts) = run_single_and_on_two_hosts(OBSTACLE_AVOIDANCE, &common);
     let multi_summary = summary(multi.path());
     assert_eq!(multi_summary["ticks"], 150);
     let shares = multi_summary["hosts"]["hosts"]
@@ -192,6 +193,23 @@ fn single_and_two_hosts(extra: &[&str]) -> (serde_json::Value, serde_json::Value
         "events.csv of the two-host run differs from the single-host run with the same seed"
     );
     (summary(single.path()), multi_summary, hosts)
+}
+
+#[test]
+fn messages_between_robots_on_two_hosts_have_the_fates_they_have_on_one() {
+    let (single, multi, hosts) =
+        run_single_and_on_two_hosts("configs/messages/talk.argos", &["--ticks", "40"]);
+    for file in ["messages.csv", "trajectory.csv"] {
+        assert!(
+            read(single.path(), file) == read(multi.path(), file),
+            "{file} of the two-host run differs from the single-host run with the same seed"
+        );
+    }
+    let messages = String::from_utf8(read(multi.path(), "messages.csv")).expect("UTF-8");
+    for outcome in [",delivered,", ",lost", ",out_of_range", ",forged_sender"] {
+        assert!(messages.contains(outcome), "no `{outcome}` in:\n{messages}");
+    }
+    hosts.stop_and_check_clean();
 }
 
 #[test]

@@ -315,6 +315,9 @@ pub fn build(
         }
         b.pheromone(p.cell_size as f32, rates);
     }
+    if let Some(medium) = &exp.media.messages {
+        b.messages(medium);
+    }
 
     let mut occupied: Vec<Placed> = Vec::new();
     let mut rng = stream(seed, Purpose::Placement, 0);

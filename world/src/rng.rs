@@ -29,6 +29,8 @@ pub enum Purpose {
     RangeFinder = 8,
     /// The loop functions' own draws (e.g. where food items appear).
     LoopFunctions = 9,
+    /// Addressed-message loss (`<messages loss>`).
+    Messages = 10,
 }
 
 /// The stream for `purpose` and `index` (a robot index, or 0 for world-wide purposes) of the run `seed`.

@@ -8,7 +8,9 @@
 
 use swarm_contract::bodies::{BodyModel, CameraView, EPUCK};
 use swarm_contract::config::Experiment;
+use swarm_contract::config::MessagesMedium;
 use swarm_contract::config::faults::DeadBodies;
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use crate::actuators;
@@ -23,6 +25,7 @@ use crate::geometry::{Placed, Vec2};
 use crate::gripper::GripperState;
 use crate::loop_functions::{LoopFunctions, LoopFunctionsRegistry, default::DefaultLoopFunctions};
 use crate::media::led::LedMedium;
+use crate::media::mail::{MailMedium, MessageRecord, Participant};
 use crate::media::pheromone::{ChannelRates, PheromoneField};
 use crate::media::rab::RabMedium;
 use crate::physics::{Motion, Physics};
@@ -48,6 +51,7 @@ pub struct WorldBuilder {
     arena: Arena,
     seed: u64,
     loop_functions: Box<dyn LoopFunctions>,
+    mail: Option<MailMedium>,
 }
 
 impl WorldBuilder {
@@ -74,6 +78,7 @@ impl WorldBuilder {
             },
             seed,
             loop_functions: Box::new(DefaultLoopFunctions),
+            mail: None,
         }
     }
 
@@ -239,6 +244,11 @@ impl WorldBuilder {
         self.arena.pheromone = PheromoneField::new(self.arena.min, self.arena.max, cell, rates);
     }
 
+    /// Gives the world a messages medium (`<messages>`): addressed messages between the run's participants.
+    pub fn messages(&mut self, medium: &MessagesMedium) {
+        self.mail = Some(MailMedium::new(medium, self.seed));
+    }
+
     /// Sets the loop functions (the default ones record basic metrics only).
     pub fn loop_functions(&mut self, loop_functions: Box<dyn LoopFunctions>) {
         self.loop_functions = loop_functions;
@@ -257,6 +267,8 @@ impl WorldBuilder {
             max_ticks: None,
             dead_bodies: DeadBodies::Inert,
             pending_gripper_events: Vec::new(),
+            mail: self.mail,
+            participants: Vec::new(),
         };
         world.update_media();
         world
@@ -276,6 +288,10 @@ pub struct World {
     dead_bodies: DeadBodies,
     /// Gripper events that happened between ticks (a robot killed by a fault), reported with the next tick's.
     pending_gripper_events: Vec<GripperEvent>,
+    /// The messages medium, if the run has one.
+    mail: Option<MailMedium>,
+    /// Every participant's state for the messages medium, refilled each tick.
+    participants: Vec<Participant>,
 }
 
 impl World {
@@ -317,6 +333,41 @@ impl World {
     pub fn is_finished(&self) -> bool {
         self.max_ticks.is_some_and(|m| self.arena.tick >= m)
             || self.loop_functions.is_finished(&self.arena)
+    }
+
+    /// Whether the run has a messages medium.
+    pub fn has_mail(&self) -> bool {
+        self.mail.is_some()
+    }
+
+    /// Decides the fate of the messages sent in `tick` (`outboxes`, one per sender in participant order) by the
+    /// messages medium: `inboxes` (one per participant: the robots, then the participants without a body such
+    /// as coordinators) get what each receives in the next tick, `records` every decision. `up` says per
+    /// participant whether it takes part; a robot must also be alive in the world. Without a medium nothing is
+    /// delivered or recorded.
+    pub fn route_mail(
+        &mut self,
+        tick: u64,
+        outboxes: &[Mailbox],
+        up: &[bool],
+        inboxes: &mut [Mailbox],
+        records: &mut Vec<MessageRecord>,
+    ) {
+        let Some(mail) = &mut self.mail else {
+            return;
+        };
+        let robots = &self.arena.robots;
+        self.participants.clear();
+        self.participants.extend(up.iter().enumerate().map(
+            |(index, &up)| match robots.get(index) {
+                Some(robot) => Participant {
+                    up: up && robot.alive,
+                    position: Some(robot.position),
+                },
+                None => Participant { up, position: None },
+            },
+        ));
+        mail.route(tick, outboxes, &self.participants, inboxes, records);
     }
 
     /// The task metrics of the loop functions.

@@ -9,8 +9,10 @@ pub mod footbot_flocking;
 pub mod footbot_foraging;
 pub mod footbot_gripping;
 pub mod footbot_synchronization;
+pub mod mail_probe;
 pub mod sensor_probe;
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use thiserror::Error;
 
@@ -22,12 +24,27 @@ use footbot_flocking::FootbotFlocking;
 use footbot_foraging::FootbotForaging;
 use footbot_gripping::FootbotGripping;
 use footbot_synchronization::FootbotSynchronization;
+use mail_probe::MailProbe;
 use sensor_probe::SensorProbe;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
 pub trait NativeController: Send {
     /// One control step. Must not allocate.
     fn step(&mut self, frame: &SensorFrame, command: &mut ActuatorCommand);
+
+    /// One control step of a controller that talks (docs/messages.md): `inbox` holds the messages delivered this
+    /// tick, and whatever the step puts into `outbox` (empty at the start of every tick) is sent with the
+    /// command. By default messages are ignored and [`NativeController::step`] runs. Must not allocate.
+    fn step_with_mail(
+        &mut self,
+        frame: &SensorFrame,
+        inbox: &Mailbox,
+        outbox: &mut Mailbox,
+        command: &mut ActuatorCommand,
+    ) {
+        let _ = (inbox, outbox);
+        self.step(frame, command);
+    }
 }
 
 /// A native controller ready to run.
@@ -57,6 +74,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (DiscWander::NAME, |p| {
         Ok(Box::new(DiscWander::from_params(p)?))
+    }),
+    (MailProbe::NAME, |p| {
+        Ok(Box::new(MailProbe::from_params(p)?))
     }),
     (SensorProbe::NAME, |p| {
         Ok(Box::new(SensorProbe::from_params(p)?))

@@ -27,6 +27,7 @@ pub mod disk_budget;
 pub mod fault_plan;
 pub mod limits;
 pub mod logging;
+pub mod mail;
 pub mod messages;
 pub mod player;
 pub mod process;

@@ -17,7 +17,7 @@ use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`SensorFrame`] and [`ActuatorCommand`]; part of every service name.
-pub const MESSAGE_VERSION: u32 = 9;
+pub const MESSAGE_VERSION: u32 = 10;
 
 /// Most proximity sensors a body has (the foot-bot's 24; the e-puck has 8).
 pub const MAX_PROXIMITY_SENSORS: usize = 24;
@@ -123,6 +123,8 @@ pub struct SensorFrame {
     pub camera_len: u8,
     /// Number of valid entries in `rab`.
     pub rab_len: u8,
+    /// Number of messages waiting in the robot's inbox this tick (`crate::mail`; 0: the agent need not look).
+    pub inbox_len: u8,
     /// Proximity readings in [0, 1] (0 nothing, 1 touching), sensor i at the body's i-th proximity angle
     /// (`crate::bodies::BodyModel::proximity_angles_deg`).
     pub proximity: [f32; MAX_PROXIMITY_SENSORS],
@@ -180,6 +182,7 @@ impl SensorFrame {
             camera: [CameraBlob::default(); MAX_CAMERA_BLOBS],
             rab_len: 0,
             rab: [RabMessage::default(); MAX_RAB_MESSAGES],
+            inbox_len: 0,
             pheromone: [0.0; PHEROMONE_CHANNELS],
             pheromone_gradient: [[0.0; 2]; PHEROMONE_CHANNELS],
             position: [0.0; 2],
@@ -351,6 +354,8 @@ pub struct ActuatorCommand {
     pub rab_len: u8,
     /// Range-and-bearing payload.
     pub rab_payload: [u8; RAB_PAYLOAD_BYTES],
+    /// Number of messages the robot put in its outbox this tick (`crate::mail`; 0: the world need not look).
+    pub outbox_len: u8,
     /// Gripper action: for the virtual gripper, pick or drop a target; for the foot-bot's physical gripper,
     /// `Pick` locks it (it grips what comes within reach) and `Drop` unlocks it.
     pub gripper: GripperAction,
@@ -392,6 +397,7 @@ impl ActuatorCommand {
             beacon: Rgb::OFF,
             rab_len: 0,
             rab_payload: [0; RAB_PAYLOAD_BYTES],
+            outbox_len: 0,
             gripper: GripperAction::Hold,
             turret_mode: Turret::Position,
             turret: 0.0,

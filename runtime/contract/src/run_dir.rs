@@ -18,6 +18,8 @@ pub const SUMMARY_FILE: &str = "summary.json";
 pub const TRAJECTORY_FILE: &str = "trajectory.csv";
 /// Every event every robot fired.
 pub const EVENTS_FILE: &str = "events.csv";
+/// Every addressed message's fate (runs with a `<messages>` medium).
+pub const MESSAGES_FILE: &str = "messages.csv";
 /// Each controller's event names by id, for the world's `events.csv`.
 pub const EVENT_TABLES_FILE: &str = "event_tables.json";
 /// The configuration as the run used it.

@@ -130,11 +130,11 @@ pub enum WireError {
 
 /// Encodes one batch into `buf` (cleared first): the header, then `(robot, entry)` for each robot. Allocates only
 /// when `buf` has to grow.
-pub fn encode_batch<'a, T: Encode + 'a>(
+pub fn encode_batch<T: Encode>(
     buf: &mut Vec<u8>,
     header: &Header,
     robots: &[u32],
-    entries: impl IntoIterator<Item = &'a T>,
+    entries: impl IntoIterator<Item = T>,
 ) -> Result<(), WireError> {
     buf.clear();
     let malformed = |e: bincode::error::EncodeError| WireError::Malformed(e.to_string());
@@ -273,7 +273,7 @@ mod tests {
     fn encoded(robots: &[u32], tick: u64) -> Vec<u8> {
         let mut buf = Vec::new();
         let header = Header::new(Kind::Frames, 77, 1, 3, tick);
-        encode_batch(&mut buf, &header, robots, &frames(robots, tick)).expect("encodes");
+        encode_batch(&mut buf, &header, robots, frames(robots, tick)).expect("encodes");
         buf
     }
 
@@ -299,7 +299,7 @@ mod tests {
             &mut buf,
             &Header::new(Kind::Replies, 1, 0, 0, 8),
             &robots,
-            &replies,
+            replies,
         )
         .expect("encodes");
         let mut out = [Reply::Missing; 3];
@@ -353,7 +353,7 @@ mod tests {
         let mut header = Header::new(Kind::Frames, 1, 0, 0, 1);
         header.version = WIRE_VERSION + 1;
         let mut buf = Vec::new();
-        encode_batch(&mut buf, &header, &[1], &frames(&[1], 1)).expect("encodes");
+        encode_batch(&mut buf, &header, &[1], frames(&[1], 1)).expect("encodes");
         let err = decode_batch(&buf, Kind::Frames, &[1], &mut out, 1 << 20).expect_err("version");
         assert_eq!(
             err,
@@ -404,7 +404,7 @@ mod tests {
             &mut buf,
             &Header::new(Kind::Replies, 1, 0, 0, 1),
             &robots,
-            &replies,
+            replies,
         )
         .expect("encodes");
         // Flip every byte in turn: each result is a decoded batch or a named error, never a panic.

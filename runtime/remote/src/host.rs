@@ -31,9 +31,10 @@ use super::auth::{Seal, answer_channel};
 use super::codec::{self, Header, Kind};
 use super::host_to_world::{AssignmentReply, OrderReply, Reply};
 use super::session::{ZenohOptions, zenoh_error};
-use super::world_to_host::{Assignment, Order, OrderAction, parse_kill};
+use super::world_to_host::{Assignment, FrameEntry, Order, OrderAction, parse_kill};
 use super::{RemoteError, keys};
-use swarm_contract::messages::{SensorFrame, SupervisorSnapshot};
+use swarm_contract::mail::Mailbox;
+use swarm_contract::messages::SupervisorSnapshot;
 use swarm_contract::process::binaries::Binaries;
 use swarm_contract::process::children::{self, Children};
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs, start_agent};
@@ -436,8 +437,10 @@ struct Share {
     /// The robot-agent program and the folder of the agents' logs, for replacements.
     agent: PathBuf,
     logs: PathBuf,
-    frames: Vec<SensorFrame>,
+    frames: Vec<FrameEntry>,
     replies: Vec<Reply>,
+    /// Per slot: the messages its robot sent in the last tick, if any.
+    outboxes: Vec<Option<Box<Mailbox>>>,
     buf: Vec<u8>,
     last_tick: u64,
     /// Number of the last fault order carried out (orders are numbered by the world, growing).
@@ -496,6 +499,7 @@ impl Share {
         link_config.tick_deadline = Duration::from_millis(assignment.tick_deadline_ms);
         link_config.pin_chains = assignment.pin_agents;
         link_config.realtime = priority::tick_at_realtime(assignment.realtime_priority);
+        link_config.mail = assignment.mail;
         let link = WorldLink::create(&spec, link_config)?;
         let replies_key = keys::replies(run, &options.name);
         let publisher = session
@@ -545,8 +549,9 @@ impl Share {
         let robots: Vec<u32> = assignment.robots.iter().map(|(id, _)| *id).collect();
         let mut share = Share {
             robots,
-            frames: vec![SensorFrame::empty(0); count as usize],
+            frames: vec![FrameEntry::empty(0); count as usize],
             replies: vec![Reply::Missing; count as usize],
+            outboxes: vec![None; count as usize],
             buf: Vec::new(),
             last_tick: 0,
             last_order: 0,
@@ -719,7 +724,7 @@ impl Share {
             .frames
             .iter()
             .zip(&self.replies)
-            .filter(|(frame, _)| frame.alive != 0)
+            .filter(|(entry, _)| entry.frame.alive != 0)
             .peekable();
         live.peek().is_some() && live.all(|(_, reply)| matches!(reply, Reply::Answered(_)))
     }
@@ -815,18 +820,27 @@ impl Share {
         let Some(link) = self.link.as_mut() else {
             return Ok(());
         };
-        let frames = &self.frames;
         link.start_at(header.tick);
+        for (slot, entry) in (0..).zip(self.frames.iter_mut()) {
+            if let Some(inbox) = entry.inbox.as_deref_mut() {
+                link.post(slot, inbox);
+            }
+        }
+        let frames = &self.frames;
         link.tick_with(|_, first, local| {
-            local.copy_from_slice(&frames[first..first + local.len()]);
+            for (frame, entry) in local.iter_mut().zip(&frames[first..]) {
+                *frame = entry.frame;
+            }
         })?;
-        for (slot, reply) in self.replies.iter_mut().enumerate() {
+        for (slot, (reply, outbox)) in self.replies.iter_mut().zip(&mut self.outboxes).enumerate() {
+            *outbox = None;
             // `Dead` means the process ended: an agent the world froze or stopped waiting for is `Missing`.
             *reply = match (link.statuses()[slot], link.command(slot as u32)) {
                 (CommandStatus::Answered, Some(command)) => {
                     let mut command = *command;
                     command.robot = self.robots[slot];
                     command.tick = header.tick;
+                    *outbox = link.outbox(slot as u32).map(Box::new);
                     Reply::Answered(command)
                 }
                 _ if agents[slot].is_none() => Reply::Dead,
@@ -848,7 +862,12 @@ impl Share {
             self.assignment.epoch,
             header.tick,
         );
-        codec::encode_batch(&mut self.buf, &out, &self.robots, &self.replies)?;
+        let entries = self
+            .replies
+            .iter()
+            .zip(&self.outboxes)
+            .map(|(reply, outbox)| (reply, outbox.as_deref()));
+        codec::encode_batch(&mut self.buf, &out, &self.robots, entries)?;
         self.seal.seal(&self.replies_key, &mut self.buf);
         self.publisher
             .put(self.buf.clone())

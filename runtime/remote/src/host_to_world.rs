@@ -1,10 +1,11 @@
 //! From a host daemon to the world: its answer to a share ([`AssignmentReply`]) and to a fault order
-//! ([`OrderReply`]) and, every tick, one batch of its robots' [`Reply`]s (a
+//! ([`OrderReply`]) and, every tick, one batch of its robots' [`ReplyEntry`]s (a
 //! [`Kind::Replies`](crate::codec::Kind) batch, see [`crate::codec`]). What the world sends is in
 //! `world_to_host.rs`.
 
 use bincode::{Decode, Encode};
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::ActuatorCommand;
 
 /// A host's answer for one robot in one tick.
@@ -19,6 +20,29 @@ pub enum Reply {
     Missing,
     /// The agent is dead (its process ended).
     Dead,
+}
+
+/// One robot's entry of a replies batch: its reply and, when it sent messages, its outbox. The host encodes the
+/// pair `(&Reply, Option<&Mailbox>)`, which has the same encoding.
+#[derive(Debug, Clone, PartialEq, Encode, Decode)]
+pub struct ReplyEntry {
+    /// The reply.
+    pub reply: Reply,
+    /// The messages the robot sent this tick, if any (the world takes the sender from the entry's robot).
+    pub outbox: Option<Box<Mailbox>>,
+}
+
+impl ReplyEntry {
+    /// The entry of a robot that did not answer.
+    pub const MISSING: ReplyEntry = ReplyEntry {
+        reply: Reply::Missing,
+        outbox: None,
+    };
+}
+
+/// The entries of a replies batch whose robots sent no messages, for [`crate::codec::encode_batch`].
+pub fn without_outboxes(replies: &[Reply]) -> impl Iterator<Item = (&Reply, Option<&Mailbox>)> {
+    replies.iter().map(|reply| (reply, None))
 }
 
 /// The host's answer to an [`Assignment`](crate::world_to_host::Assignment).

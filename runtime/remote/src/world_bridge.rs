@@ -28,10 +28,11 @@ use zenoh::{Session, Wait};
 
 use super::auth::{HostKeys, Seal, answer_channel};
 use super::codec::{self, Header, Kind};
-use super::host_to_world::{AssignmentReply, OrderReply, Reply};
+use super::host_to_world::{AssignmentReply, OrderReply, Reply, ReplyEntry};
 use super::session::{ZenohOptions, zenoh_error};
 use super::world_to_host::{Assignment, Order, OrderAction, kill_payload};
 use super::{RemoteError, keys};
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::transport::{CommandStatus, TickOutcome};
 
@@ -74,6 +75,8 @@ pub struct RemoteOptions {
     pub pin_agents: bool,
     /// Whether the hosts tick and run their agents at real-time priority if they can.
     pub realtime_priority: bool,
+    /// Whether the run has a messages medium (the hosts' local runs then carry inboxes and outboxes).
+    pub mail: bool,
     /// Largest payload accepted.
     pub max_payload: usize,
     /// The run's compiled supervisor sets by controller id, handed to every host with its share.
@@ -171,7 +174,7 @@ struct Host {
     live_from: u64,
     /// It rejoined and its robots' return is still to be told (at the end of tick `live_from`).
     returning: bool,
-    replies: Vec<Reply>,
+    replies: Vec<ReplyEntry>,
     publisher: Publisher<'static>,
     /// How the host's messages are authenticated, and the channel its frames are tagged for.
     seal: Seal,
@@ -193,6 +196,12 @@ pub struct RemoteHosts {
     sender: Sender<Incoming>,
     frames: Vec<SensorFrame>,
     commands: Vec<ActuatorCommand>,
+    /// Per robot: the messages it receives in the next tick ([`RemoteHosts::post`]); empty until the first post.
+    inboxes: Vec<Mailbox>,
+    /// Per robot: whether `inboxes` holds messages for the next tick.
+    posted: Vec<bool>,
+    /// Per robot: the messages it sent in the last tick.
+    outboxes: Vec<Option<Box<Mailbox>>>,
     status: Vec<CommandStatus>,
     /// Index in `hosts` of each robot's host.
     owner: Vec<usize>,
@@ -300,7 +309,7 @@ impl RemoteHosts {
                 .wait()
                 .map_err(zenoh_error("declaring a frames publisher"))?;
             hosts.push(Host {
-                replies: vec![Reply::Missing; share.robots.len()],
+                replies: vec![ReplyEntry::MISSING; share.robots.len()],
                 share: share.clone(),
                 state: State::Absent,
                 up: false,
@@ -334,6 +343,9 @@ impl RemoteHosts {
             sender,
             frames: (0..robots).map(SensorFrame::empty).collect(),
             commands: (0..robots).map(|r| ActuatorCommand::idle(r, 0)).collect(),
+            inboxes: Vec::new(),
+            posted: vec![false; n],
+            outboxes: vec![None; n],
             status: vec![CommandStatus::Missing; n],
             owner,
             present: vec![true; n],
@@ -453,7 +465,12 @@ impl RemoteHosts {
                 continue;
             }
             let header = Header::new(Kind::Frames, self.run, index as u16, host.epoch, tick);
-            let frames = host.share.robots.iter().map(|&r| &self.frames[r as usize]);
+            let (inboxes, posted) = (&self.inboxes, &self.posted);
+            let frames = host.share.robots.iter().map(|&r| {
+                let r = r as usize;
+                let inbox = posted[r].then(|| &inboxes[r]);
+                (&self.frames[r], inbox)
+            });
             codec::encode_batch(&mut self.buf, &header, &host.share.robots, frames)?;
             host.seal.seal(&host.frames_key, &mut self.buf);
             host.publisher
@@ -462,6 +479,7 @@ impl RemoteHosts {
                 .map_err(zenoh_error("publishing frames"))?;
         }
         self.sent = true;
+        self.posted.fill(false);
         let deadline = Instant::now() + self.options.tick_deadline;
         while self
             .hosts
@@ -500,9 +518,12 @@ impl RemoteHosts {
             }
             for (slot, &robot) in host.share.robots.iter().enumerate() {
                 let r = robot as usize;
-                let status = match (live, host.answered == tick, host.replies[slot]) {
+                let entry = &mut host.replies[slot];
+                self.outboxes[r] = None;
+                let status = match (live, host.answered == tick, entry.reply) {
                     (true, true, Reply::Answered(command)) => {
                         self.commands[r] = command;
+                        self.outboxes[r] = entry.outbox.take();
                         CommandStatus::Answered
                     }
                     (true, true, Reply::Dead) => {
@@ -617,6 +638,7 @@ impl RemoteHosts {
             agent_exit_grace_ms: self.options.agent_exit_grace.as_millis() as u64,
             pin_agents: self.options.pin_agents,
             realtime_priority: self.options.realtime_priority,
+            mail: self.options.mail,
             compiled_supervisors: self.options.compiled_supervisors.clone(),
             limits: self.options.limits.clone(),
             resume: if host.epoch > 1 {
@@ -803,7 +825,7 @@ impl RemoteHosts {
         ) {
             Ok(_) => {
                 let owned = host.replies.iter().zip(&host.share.robots).all(
-                    |(reply, &robot)| !matches!(reply, Reply::Answered(c) if c.robot != robot),
+                    |(entry, &robot)| !matches!(entry.reply, Reply::Answered(c) if c.robot != robot),
                 );
                 if owned {
                     host.answered = self.tick;
@@ -829,6 +851,30 @@ impl RemoteHosts {
             Some(CommandStatus::Answered) => self.commands.get(r),
             _ => None,
         }
+    }
+
+    /// Puts `inbox` into `robot`'s inbox for the next tick (sent with its frame); see `WorldLink::post`.
+    pub fn post(&mut self, robot: u32, inbox: &mut Mailbox) {
+        let r = robot as usize;
+        if r >= self.posted.len() {
+            return;
+        }
+        if self.inboxes.is_empty() {
+            self.inboxes = (0..self.posted.len() as u32).map(Mailbox::empty).collect();
+        }
+        inbox.tick = self.tick + 1;
+        inbox.owner = robot;
+        self.inboxes[r] = *inbox;
+        self.posted[r] = true;
+    }
+
+    /// The messages `robot` sent in the last tick; `None` when it did not answer or sent nothing. The sender is
+    /// the robot whose entry carried them, whatever the host put in the outbox.
+    pub fn outbox(&self, robot: u32) -> Option<Mailbox> {
+        self.command(robot)?;
+        let mut outbox = **self.outboxes.get(robot as usize)?.as_ref()?;
+        outbox.owner = robot;
+        Some(outbox)
     }
 
     /// What the world got from each robot in the last tick, indexed by robot.
@@ -963,6 +1009,8 @@ mod tests {
 
     use super::*;
     use crate::auth::HostKey;
+    use crate::host_to_world::without_outboxes;
+    use crate::world_to_host::FrameEntry;
 
     /// How a fake host answers frames.
     #[derive(Clone, Copy)]
@@ -1072,7 +1120,7 @@ mod tests {
                 let Ok((robots, frames, publisher, forged)) = share_rx.recv() else {
                     return;
                 };
-                let mut out = vec![SensorFrame::empty(0); robots.len()];
+                let mut out = vec![FrameEntry::empty(0); robots.len()];
                 let mut buf = Vec::new();
                 while !flag.load(Ordering::Relaxed) {
                     let Ok(Some(sample)) = frames.recv_timeout(Duration::from_millis(20)) else {
@@ -1103,8 +1151,13 @@ mod tests {
                             Reply::Answered(command)
                         })
                         .collect();
-                    codec::encode_batch(&mut buf, &reply_header, &claimed, &replies)
-                        .expect("encodes");
+                    codec::encode_batch(
+                        &mut buf,
+                        &reply_header,
+                        &claimed,
+                        without_outboxes(&replies),
+                    )
+                    .expect("encodes");
                     if let Behaviour::Garbage = behaviour {
                         buf = b"not a batch".to_vec();
                     }
@@ -1118,7 +1171,7 @@ mod tests {
                             &mut buf,
                             &header,
                             &[robot],
-                            &[Reply::Answered(command)],
+                            without_outboxes(&[Reply::Answered(command)]),
                         )
                         .expect("encodes");
                         seal.seal(forged.key_expr().as_str(), &mut buf);
@@ -1167,6 +1220,7 @@ mod tests {
             agent_exit_grace: Duration::from_secs(5),
             pin_agents: true,
             realtime_priority: false,
+            mail: false,
             max_payload: codec::DEFAULT_MAX_PAYLOAD,
             compiled_supervisors: Vec::new(),
             limits: Vec::new(),

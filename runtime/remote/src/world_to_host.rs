@@ -1,7 +1,6 @@
 //! From the world to a host daemon: the host's share of a run ([`Assignment`]), fault orders for its robots'
-//! agents ([`Order`]) and, every tick, one batch of its robots' sensor frames (a
-//! [`Kind::Frames`](crate::codec::Kind) batch of [`SensorFrame`](swarm_contract::messages::SensorFrame)s, see
-//! [`crate::codec`]).
+//! agents ([`Order`]) and, every tick, one batch of its robots' sensor frames with their inboxes (a
+//! [`Kind::Frames`](crate::codec::Kind) batch of [`FrameEntry`]s, see [`crate::codec`]).
 //!
 //! **The share** names the experiment by path (every host must see the same configuration and model files at the
 //! same path, e.g. one checkout or a shared file system), the run seed, the run-wide ids and controllers of the
@@ -22,7 +21,35 @@ use std::path::PathBuf;
 
 use bincode::{Decode, Encode};
 
-use swarm_contract::messages::SupervisorSnapshot;
+use swarm_contract::mail::Mailbox;
+use swarm_contract::messages::{SensorFrame, SupervisorSnapshot};
+
+/// One robot's entry of a frames batch: its frame and, when messages wait for it, its inbox. The world encodes
+/// the pair `(&SensorFrame, Option<&Mailbox>)`, which has the same encoding.
+#[derive(Debug, Clone, PartialEq, Encode, Decode)]
+pub struct FrameEntry {
+    /// The frame.
+    pub frame: SensorFrame,
+    /// The messages delivered to the robot this tick, if any.
+    pub inbox: Option<Box<Mailbox>>,
+}
+
+impl FrameEntry {
+    /// An empty entry for `robot`.
+    pub fn empty(robot: u32) -> FrameEntry {
+        FrameEntry {
+            frame: SensorFrame::empty(robot),
+            inbox: None,
+        }
+    }
+}
+
+/// The entries of a frames batch whose robots receive no messages, for [`crate::codec::encode_batch`].
+pub fn without_inboxes(
+    frames: &[SensorFrame],
+) -> impl Iterator<Item = (&SensorFrame, Option<&Mailbox>)> {
+    frames.iter().map(|frame| (frame, None))
+}
 
 /// What the world asks a host to run.
 #[derive(Debug, Clone, PartialEq, Encode, Decode)]
@@ -54,6 +81,8 @@ pub struct Assignment {
     /// Whether the host's ticking thread and agents run at real-time priority if the host allows it
     /// (`<system realtime_priority>`).
     pub realtime_priority: bool,
+    /// Whether the run has a messages medium: the host's local run then carries inboxes and outboxes.
+    pub mail: bool,
     /// The run's compiled supervisor sets (the launcher compiles each controller's models once per run), by
     /// controller id: the host's agents load these instead of compiling the models themselves. A native
     /// controller has none.

@@ -12,6 +12,7 @@
 
 mod faults;
 mod pacing;
+mod post;
 mod remote;
 mod ticking_cpu;
 
@@ -36,6 +37,7 @@ use swarm_world::recorder::Recorder;
 
 use faults::FaultDriver;
 use pacing::Pacer;
+use post::PostOffice;
 use remote::Link;
 use ticking_cpu::TickingCpu;
 
@@ -106,6 +108,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     link_config.tick_deadline = limits.tick_deadline();
     link_config.pin_chains = experiment.framework.pin_agents;
     link_config.realtime = priority::tick_at_realtime(experiment.framework.realtime_priority);
+    link_config.mail = world.has_mail();
     let (mut link, launcher) = match HostsPlan::resolve(experiment.framework.hosts.as_ref(), hosts)?
     {
         None => {
@@ -122,6 +125,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 &limits,
                 link_config.pin_chains,
                 experiment.framework.realtime_priority,
+                link_config.mail,
             )?;
             (link, faults::follow_launcher(None))
         }
@@ -136,6 +140,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         &limits,
     )?;
     let mut recorder = Recorder::create(&args.out, &world, &[0])?;
+    let mut post = PostOffice::new(&world, link.robots());
     recorder.record(&mut world)?;
     report(WorldReport::Ready {
         robots: robots as u32,
@@ -180,6 +185,9 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             }
         }
         world.act_and_step(&commands, &has_command);
+        if let Some(post) = &mut post {
+            post.after_tick(&mut link, &mut world, &faults, &mut recorder);
+        }
         recorder.record(&mut world)?;
         tick_micros.push(u32::try_from(tick_started.elapsed().as_micros()).unwrap_or(u32::MAX));
         robot_steps += u64::from(outcome.answered);

@@ -11,6 +11,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
 use swarm_contract::limits::Limits;
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame, SupervisorSnapshot};
 use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::run_dir;
@@ -69,6 +70,7 @@ impl Link {
         limits: &Limits,
         pin_agents: bool,
         realtime_priority: bool,
+        mail: bool,
     ) -> anyhow::Result<Link> {
         let robots = controllers.len() as u32;
         let hosts = plan.place(robots);
@@ -88,6 +90,7 @@ impl Link {
             agent_exit_grace: limits.agent_exit_grace(),
             pin_agents,
             realtime_priority,
+            mail,
             max_payload: limits.max_host_message(),
             compiled_supervisors,
             limits: args.limits.clone(),
@@ -142,6 +145,24 @@ impl Link {
         match self {
             Link::Local(link) => link.command(robot),
             Link::Remote(hosts) => hosts.command(robot),
+        }
+    }
+
+    /// Puts `inbox` into `robot`'s inbox for the next tick; see `WorldLink::post`.
+    pub fn post(&mut self, robot: u32, inbox: &mut Mailbox) {
+        match self {
+            Link::Local(link) => {
+                link.post(robot, inbox);
+            }
+            Link::Remote(hosts) => hosts.post(robot, inbox),
+        }
+    }
+
+    /// The messages `robot` sent in the last tick; see `WorldLink::outbox`.
+    pub fn outbox(&self, robot: u32) -> Option<Mailbox> {
+        match self {
+            Link::Local(link) => link.outbox(robot),
+            Link::Remote(hosts) => hosts.outbox(robot),
         }
     }
 

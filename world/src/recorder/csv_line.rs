@@ -43,6 +43,13 @@ impl<'a, W: Write> CsvLine<'a, W> {
         Ok(self)
     }
 
+    /// A float appended to the field just written (`within:` then `0.5`), shortest round-trip digits.
+    pub fn float_joined(self, value: f32) -> std::io::Result<Self> {
+        self.out
+            .write_all(ryu::Buffer::new().format(value).as_bytes())?;
+        Ok(self)
+    }
+
     /// A text field, as is (the caller's text holds no comma, quote or line break).
     pub fn text(mut self, value: &str) -> std::io::Result<Self> {
         self.separate()?;

@@ -1,13 +1,16 @@
-//! The per-tick record files as the recorder's thread writes them: `events.csv` and `trajectory.csv` together.
+//! The per-tick record files as the recorder's thread writes them: `events.csv`, `messages.csv` (runs with
+//! mail) and `trajectory.csv` together.
 //!
-//! A tick's batch ends with its poses, and the events file is flushed before the trajectory file. So whenever
-//! the trajectory holds a tick for every robot, the events of that tick are on disk too: the launcher's cut-back
+//! A tick's batch ends with its poses, and the events and messages files are flushed before the trajectory file.
+//! So whenever the trajectory holds a tick for every robot, the events and messages of that tick are on disk too: the launcher's cut-back
 //! after a world death (`runtime/cli/src/launcher/records.rs`) trusts the trajectory to say which ticks are whole.
 
 use super::background::RowWriter;
 use super::events::{EventRow, EventsWriter};
+use super::messages::MessagesWriter;
 use super::trajectory::{PoseRow, TrajectoryWriter};
 use crate::error::WorldError;
+use crate::media::mail::MessageRecord;
 
 /// One row of either file.
 #[derive(Clone, Copy, Debug)]
@@ -16,6 +19,8 @@ pub enum RecordRow {
     Event(EventRow),
     /// A row of `trajectory.csv`.
     Pose(PoseRow),
+    /// A row of `messages.csv`.
+    Message(MessageRecord),
 }
 
 /// Both files.
@@ -24,6 +29,8 @@ pub struct RecordFiles {
     pub events: EventsWriter,
     /// `trajectory.csv`.
     pub trajectory: TrajectoryWriter,
+    /// `messages.csv`, in runs with a messages medium.
+    pub messages: Option<MessagesWriter>,
 }
 
 impl RowWriter for RecordFiles {
@@ -34,9 +41,17 @@ impl RowWriter for RecordFiles {
             match row {
                 RecordRow::Event(row) => self.events.write_row(row)?,
                 RecordRow::Pose(row) => self.trajectory.write_row(row)?,
+                RecordRow::Message(row) => {
+                    if let Some(messages) = &mut self.messages {
+                        messages.write_row(row)?;
+                    }
+                }
             }
         }
         self.events.flush()?;
+        if let Some(messages) = &mut self.messages {
+            messages.flush()?;
+        }
         self.trajectory.flush()
     }
 }

@@ -1,4 +1,5 @@
 //! The run record: `trajectory.csv` (one row per robot per tick), `events.csv` (every fired event and fault),
+//! `messages.csv` (every addressed message's fate, in runs with a messages medium),
 //! `summary.json` (the loop functions' metrics and run facts) and PNG snapshots at chosen ticks.
 //!
 //! The tick loop only copies plain rows; a thread of the recorder's own formats, writes and flushes them, one
@@ -8,6 +9,7 @@ pub mod background;
 mod csv_line;
 pub mod events;
 pub mod files;
+pub mod messages;
 pub mod snapshot;
 pub mod trajectory;
 
@@ -25,6 +27,7 @@ use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::GripperEvent;
 use crate::error::WorldError;
+use crate::media::mail::MessageRecord;
 use crate::world::World;
 
 /// Records one run into a directory.
@@ -70,6 +73,10 @@ impl Recorder {
         let files = RecordFiles {
             events: EventsWriter::create(dir, &world.arena)?,
             trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
+            messages: world
+                .has_mail()
+                .then(|| messages::MessagesWriter::create(dir))
+                .transpose()?,
         };
         let loop_output = match world.loop_output_name() {
             None => None,
@@ -102,6 +109,13 @@ impl Recorder {
                 robot: robot as u32,
                 event,
             }));
+        }
+    }
+
+    /// Records the messages medium's decisions of a tick (`messages.csv`).
+    pub fn record_messages(&mut self, records: &[MessageRecord]) {
+        for &record in records {
+            self.files.push(RecordRow::Message(record));
         }
     }
 

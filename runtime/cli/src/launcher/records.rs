@@ -1,12 +1,13 @@
-//! Making a dead world's records readable: after the world process died, `trajectory.csv` and `events.csv` are
-//! cut back to the last tick the trajectory holds completely (a half-written line or tick is dropped).
+//! Making a dead world's records readable: after the world process died, `trajectory.csv`, `events.csv` and
+//! `messages.csv` are cut back to the last tick the trajectory holds completely (a half-written line or tick is
+//! dropped).
 //!
-//! The world's recorder thread flushes a tick's events before its poses, so this only ever removes what a kill
+//! The world's recorder thread flushes a tick's events and messages before its poses, so this only ever removes what a kill
 //! in the middle of writing left behind. It never touches the records of a run whose world finished normally.
 
 use std::path::Path;
 
-use swarm_contract::run_dir::{self, EVENTS_FILE, TRAJECTORY_FILE};
+use swarm_contract::run_dir::{self, EVENTS_FILE, MESSAGES_FILE, TRAJECTORY_FILE};
 
 /// Cuts the records in `run_dir` back to the last complete tick of `robots` robots; returns that tick (`None`
 /// when the trajectory is missing or holds no complete tick).
@@ -34,13 +35,15 @@ pub fn trim_to_complete_ticks(run_dir: &Path, robots: u32) -> std::io::Result<Op
     if kept != text {
         run_dir::write_atomically(&trajectory, kept.as_bytes())?;
     }
-    let events = run_dir.join(EVENTS_FILE);
-    if let Ok(text) = std::fs::read_to_string(&events) {
-        let mut kept: Vec<&str> = complete_lines(&text).lines().collect();
-        kept.retain(|l| tick_of(l).is_none_or(|t| t <= last));
-        let kept = kept.join("\n") + "\n";
-        if kept != text {
-            run_dir::write_atomically(&events, kept.as_bytes())?;
+    for name in [EVENTS_FILE, MESSAGES_FILE] {
+        let path = run_dir.join(name);
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            let mut kept: Vec<&str> = complete_lines(&text).lines().collect();
+            kept.retain(|l| tick_of(l).is_none_or(|t| t <= last));
+            let kept = kept.join("\n") + "\n";
+            if kept != text {
+                run_dir::write_atomically(&path, kept.as_bytes())?;
+            }
         }
     }
     Ok(Some(last))
@@ -56,7 +59,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_half_written_tick_is_cut_from_both_records() {
+    fn a_half_written_tick_is_cut_from_every_record() {
         let dir = tempfile::tempdir().expect("temp dir");
         let header = "tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive\n";
         std::fs::write(
@@ -69,6 +72,11 @@ mod tests {
             "tick,robot,robot_id,event\n1,0,a,Go\n2,1,b,Go\n2,0,a,sa",
         )
         .expect("written");
+        std::fs::write(
+            dir.path().join("messages.csv"),
+            "tick,from,to,address,bytes,outcome,reason\n1,0,1,one,8,delivered,\n2,1,0,one,8,deliv",
+        )
+        .expect("written");
         assert_eq!(
             trim_to_complete_ticks(dir.path(), 2).expect("trimmed"),
             Some(1)
@@ -78,5 +86,10 @@ mod tests {
         assert!(trajectory.ends_with("1,1,b,0,0,0,0,0,0,1\n"));
         let events = std::fs::read_to_string(dir.path().join("events.csv")).expect("read");
         assert_eq!(events, "tick,robot,robot_id,event\n1,0,a,Go\n");
+        let messages = std::fs::read_to_string(dir.path().join("messages.csv")).expect("read");
+        assert_eq!(
+            messages,
+            "tick,from,to,address,bytes,outcome,reason\n1,0,1,one,8,delivered,\n"
+        );
     }
 }

@@ -881,6 +881,8 @@ pub struct Media {
     pub range_and_bearing: Option<Medium>,
     /// `<pheromone id cell_size>` (our extension): the pheromone field.
     pub pheromone: Option<PheromoneField>,
+    /// `<messages id ...>` (our extension): addressed messages between the run's participants.
+    pub messages: Option<MessagesMedium>,
 }
 
 impl Media {
@@ -889,7 +891,28 @@ impl Media {
         self.leds.as_ref().is_some_and(|m| m.id == id)
             || self.range_and_bearing.as_ref().is_some_and(|m| m.id == id)
             || self.pheromone.as_ref().is_some_and(|m| m.id == id)
+            || self.messages.as_ref().is_some_and(|m| m.id == id)
     }
+}
+
+/// `<messages id range loss max_payload max_per_tick>` (our extension; docs/messages.md): the medium of addressed
+/// messages. The world decides each message's fate by these limits and records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MessagesMedium {
+    /// `id`.
+    pub id: String,
+    /// `range`: farthest a message travels between two robots' centres, in metres (absent: any distance).
+    pub range: Option<f64>,
+    /// `loss`: probability in [0, 1] that a message between two robots is lost (default 0).
+    pub loss: f64,
+    /// `max_payload`: most payload bytes of one message (default and at most
+    /// [`crate::mail::MAIL_PAYLOAD_BYTES`]); a longer message is dropped.
+    pub max_payload: u32,
+    /// `max_per_tick`: most messages one participant sends per tick (default 8, at most
+    /// [`crate::mail::MAILBOX_CAPACITY`]); the later ones are dropped.
+    pub max_per_tick: u32,
+    /// Where the element is.
+    pub location: Location,
 }
 
 /// A declared LED or RAB medium.

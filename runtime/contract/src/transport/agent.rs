@@ -21,10 +21,11 @@ use iceoryx2::prelude::ipc;
 
 use super::TransportError;
 use super::run::RunSpec;
-use super::services::{self, Board, COMMAND_KEY};
+use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
 use super::sync_block::{JoinClaim, SyncBlock};
 use super::world_watch::WorldWatch;
 use super::{placement, priority};
+use crate::mail::Mailbox;
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// Default number of polls of the chain's wake word before an agent sleeps on it (see [`AgentLink::set_spin`]).
@@ -47,10 +48,67 @@ impl Tick<'_> {
         self.link.frame.tick
     }
 
+    /// The robot's frame and the messages delivered to it this tick (none in a run without mail). The inbox is
+    /// loaded from the inbox board only when the frame says messages wait.
+    #[unsafe(link_section = "swarm_hot")]
+    pub fn frame_and_inbox(&mut self) -> (&SensorFrame, &Mailbox) {
+        let link = &mut *self.link;
+        let tick = link.frame.tick;
+        if link.inbox.tick != tick {
+            link.inbox.clear();
+            link.inbox.tick = tick;
+            if let Some(entry) = link
+                .ports
+                .mail
+                .as_ref()
+                .filter(|_| link.frame.inbox_len > 0)
+            {
+                let posted = *entry.inbox.get();
+                if posted.tick == tick {
+                    link.inbox = posted;
+                }
+            }
+        }
+        (&link.frame, &link.inbox)
+    }
+
     /// Sends `command` as the robot's answer to this tick, with its `tick` and `robot` fields set here, and
     /// counts the robot as answered (the last answer of the tick wakes the world).
     #[unsafe(link_section = "swarm_hot")]
     pub fn answer(self, command: &mut ActuatorCommand) {
+        command.outbox_len = 0;
+        self.send_answer(command);
+    }
+
+    /// Like [`Tick::answer`], with the messages of `outbox` (the world decides their fate and delivers them in
+    /// the next tick). In a run without mail the messages go nowhere and the agent says so once.
+    #[unsafe(link_section = "swarm_hot")]
+    pub fn answer_with_mail(self, command: &mut ActuatorCommand, outbox: &Mailbox) {
+        command.outbox_len = 0;
+        if !outbox.is_empty() {
+            match self.link.ports.mail.as_ref() {
+                Some(mail) => {
+                    let mut posted = *outbox;
+                    posted.tick = self.link.frame.tick;
+                    posted.owner = self.link.robot;
+                    mail.outbox.update_with_copy(posted);
+                    command.outbox_len = outbox.messages().len() as u8;
+                }
+                None if !self.link.warned_no_mail => {
+                    self.link.warned_no_mail = true;
+                    tracing::warn!(
+                        robot = self.link.robot,
+                        "the controller sends messages, but the run has no <messages> medium: they go nowhere"
+                    );
+                }
+                None => {}
+            }
+        }
+        self.send_answer(command);
+    }
+
+    #[unsafe(link_section = "swarm_hot")]
+    fn send_answer(self, command: &mut ActuatorCommand) {
         let link = self.link;
         let tick = link.frame.tick;
         command.tick = tick;
@@ -65,11 +123,21 @@ impl Tick<'_> {
 struct Ports {
     frame_entry: EntryHandle<ipc::Service, u32, SensorFrame>,
     command_entry: EntryHandleMut<ipc::Service, u32, ActuatorCommand>,
+    mail: Option<MailPorts>,
     _frame_reader: Reader<ipc::Service, u32>,
     _command_writer: Writer<ipc::Service, u32>,
     _command_board: Board,
     _frame_board: Board,
     _node: Node<ipc::Service>,
+}
+
+/// An agent's mail ports (runs with mail only): its inbox entry and its command board's outbox entry. Fields drop
+/// in declaration order.
+struct MailPorts {
+    inbox: EntryHandle<ipc::Service, u32, Mailbox>,
+    outbox: EntryHandleMut<ipc::Service, u32, Mailbox>,
+    _inbox_reader: Reader<ipc::Service, u32>,
+    _inbox_board: Board,
 }
 
 /// An agent's end of a run's local transport, for one robot.
@@ -84,6 +152,10 @@ pub struct AgentLink {
     sync: Arc<SyncBlock>,
     /// Notices the end of the world process, so that waits need no timeout (`None`: no pidfd here).
     world_watch: Option<WorldWatch>,
+    /// The robot's inbox of the last tick it was read in ([`Tick::inbox`]).
+    inbox: Mailbox,
+    /// Whether the agent has said that its messages go nowhere (a run without mail).
+    warned_no_mail: bool,
 }
 
 impl AgentLink {
@@ -139,6 +211,8 @@ impl AgentLink {
                     ports,
                     sync,
                     world_watch,
+                    inbox: Mailbox::empty(robot),
+                    warned_no_mail: false,
                 })
             }
             Err(e) => {
@@ -197,14 +271,50 @@ impl AgentLink {
         let command_entry = command_writer
             .entry::<ActuatorCommand>(&COMMAND_KEY)
             .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
+        let mail = if sync.placement().mail {
+            let outbox = command_writer
+                .entry::<Mailbox>(&OUTBOX_KEY)
+                .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s outbox entry"), e))?;
+            Some(Self::connect_inbox(&node, robot, sync.capacity(), outbox)?)
+        } else {
+            None
+        };
         Ok(Ports {
             frame_entry,
             command_entry,
+            mail,
             _frame_reader: frame_reader,
             _command_writer: command_writer,
             _command_board: command_board,
             _frame_board: frame_board,
             _node: node,
+        })
+    }
+
+    fn connect_inbox(
+        node: &Node<ipc::Service>,
+        robot: u32,
+        capacity: u32,
+        outbox: EntryHandleMut<ipc::Service, u32, Mailbox>,
+    ) -> Result<MailPorts, TransportError> {
+        let board = services::open_inbox_board(node, robot, capacity)?;
+        let reader = board.reader_builder().create().map_err(|e| match e {
+            ReaderCreateError::ExceedsMaxSupportedReaders => TransportError::ServiceFull {
+                robot,
+                service: services::inbox_service_name(),
+                limit: capacity as usize + services::SPARE_AGENT_PLACES,
+                what: "readers",
+            },
+            other => TransportError::iceoryx("reading the inbox board", other),
+        })?;
+        let inbox = reader
+            .entry::<Mailbox>(&robot)
+            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s inbox entry"), e))?;
+        Ok(MailPorts {
+            inbox,
+            outbox,
+            _inbox_reader: reader,
+            _inbox_board: board,
         })
     }
 

@@ -14,19 +14,27 @@ use iceoryx2::service::port_factory::blackboard::PortFactory;
 
 use super::TransportError;
 use super::run::RunSpec;
+use crate::mail::Mailbox;
 use crate::messages::{ActuatorCommand, MESSAGE_VERSION, SensorFrame};
 
 /// A blackboard of the run, keyed by robot index (frames) or by [`COMMAND_KEY`] (commands).
 pub(crate) type Board = PortFactory<ipc::Service, u32>;
 
-/// The one key of a command board.
+/// The key of a command board's command.
 pub(crate) const COMMAND_KEY: u32 = 0;
+/// The key of a command board's outbox (in runs with mail only).
+pub(crate) const OUTBOX_KEY: u32 = 1;
 /// Nodes on a command board: the world and the robot's agent.
 const COMMAND_NODES: usize = 2;
 
 /// Name of the frame board.
 pub(crate) fn frame_service_name() -> String {
     format!("swarm/v{MESSAGE_VERSION}/frames")
+}
+
+/// Name of the inbox board (runs with mail only): one [`Mailbox`] per robot, keyed like the frame board.
+pub(crate) fn inbox_service_name() -> String {
+    format!("swarm/v{MESSAGE_VERSION}/inboxes")
 }
 
 /// Name of generation `generation` of robot `robot`'s command board.
@@ -76,6 +84,35 @@ pub(crate) fn create_frame_board(
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }
 
+/// World side: creates the inbox board with one mailbox per robot, readable by `robots` agents (plus spares).
+pub(crate) fn create_inbox_board(
+    node: &Node<ipc::Service>,
+    robots: u32,
+) -> Result<Board, TransportError> {
+    let name = inbox_service_name();
+    let mut creator = node
+        .service_builder(&service_name(&name)?)
+        .blackboard_creator::<u32>()
+        .max_readers(robots as usize + SPARE_AGENT_PLACES)
+        .max_nodes(robots as usize + 1 + SPARE_AGENT_PLACES);
+    for robot in 0..robots {
+        creator = creator.add::<Mailbox>(robot, Mailbox::empty(robot));
+    }
+    creator
+        .create()
+        .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
+}
+
+/// Agent side: opens the inbox board of a run of `robots` robots as robot `robot`'s agent.
+pub(crate) fn open_inbox_board(
+    node: &Node<ipc::Service>,
+    robot: u32,
+    robots: u32,
+) -> Result<Board, TransportError> {
+    let nodes = robots as usize + 1 + SPARE_AGENT_PLACES;
+    open_board(node, robot, &inbox_service_name(), nodes)
+}
+
 /// Agent side: opens the frame board of a run of `robots` robots as robot `robot`'s agent.
 pub(crate) fn open_frame_board(
     node: &Node<ipc::Service>,
@@ -87,18 +124,26 @@ pub(crate) fn open_frame_board(
 }
 
 /// World side: creates generation `generation` of robot `robot`'s command board (one writer, the robot's
-/// agent; one reader, the world).
+/// agent; one reader, the world), with an outbox entry when the run has `mail`.
 pub(crate) fn create_command_board(
     node: &Node<ipc::Service>,
     robot: u32,
     generation: u32,
+    mail: bool,
 ) -> Result<Board, TransportError> {
     let name = command_service_name(robot, generation);
-    node.service_builder(&service_name(&name)?)
+    let creator = node
+        .service_builder(&service_name(&name)?)
         .blackboard_creator::<u32>()
         .max_readers(1)
         .max_nodes(COMMAND_NODES)
-        .add::<ActuatorCommand>(COMMAND_KEY, ActuatorCommand::idle(robot, 0))
+        .add::<ActuatorCommand>(COMMAND_KEY, ActuatorCommand::idle(robot, 0));
+    let creator = if mail {
+        creator.add::<Mailbox>(OUTBOX_KEY, Mailbox::empty(robot))
+    } else {
+        creator
+    };
+    creator
         .create()
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }

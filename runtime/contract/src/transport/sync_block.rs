@@ -32,7 +32,7 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 8;
+const LAYOUT_VERSION: u32 = 9;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -58,6 +58,8 @@ struct Header {
     pin_chains: AtomicU32,
     /// 1 when each agent runs at real-time priority (`LinkConfig::realtime`).
     realtime: AtomicU32,
+    /// 1 when the run has mail boards (`LinkConfig::mail`).
+    mail: AtomicU32,
     /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
     /// once its wake word carries the tick.
     tick: AtomicU64,
@@ -93,13 +95,15 @@ struct RobotSlot {
     chain_woken: AtomicU64,
 }
 
-/// Where and how the agents of a run run, as the world tells them in the block.
+/// Where and how the agents of a run run, and what they are given, as the world tells them in the block.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct AgentPlacement {
     /// Each agent pins itself to the CPU of its chain.
     pub(crate) pin_chains: bool,
     /// Each agent runs at real-time priority.
     pub(crate) realtime: bool,
+    /// The run has an inbox board and outbox entries (`crate::mail`).
+    pub(crate) mail: bool,
 }
 
 /// A mapping of a run's sync block.
@@ -161,6 +165,9 @@ impl SyncBlock {
         header
             .realtime
             .store(u32::from(placement.realtime), Ordering::Relaxed);
+        header
+            .mail
+            .store(u32::from(placement.mail), Ordering::Relaxed);
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
@@ -296,6 +303,7 @@ impl SyncBlock {
         AgentPlacement {
             pin_chains: header.pin_chains.load(Ordering::Relaxed) != 0,
             realtime: header.realtime.load(Ordering::Relaxed) != 0,
+            mail: header.mail.load(Ordering::Relaxed) != 0,
         }
     }
 

@@ -18,8 +18,9 @@ use super::TransportError;
 use super::cleaner::Cleaner;
 use super::placement;
 use super::run::RunSpec;
-use super::services::{self, Board, COMMAND_KEY};
+use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
 use super::sync_block::{AgentPlacement, MAX_ROBOTS, SyncBlock};
+use crate::mail::Mailbox;
 use crate::messages::{ActuatorCommand, SensorFrame};
 
 /// Default time the world waits for the commands of one tick (see [`LinkConfig::tick_deadline`]).
@@ -61,6 +62,9 @@ pub struct LinkConfig {
     /// (default false). Set it once the thread that ticks the link runs at
     /// [`WORLD_PRIORITY`](super::priority::WORLD_PRIORITY): see [`priority`](super::priority).
     pub realtime: bool,
+    /// Whether the run carries addressed messages (`crate::mail`): an inbox board and an outbox entry on every
+    /// command board (default false: a run without a `<messages>` medium pays nothing for them).
+    pub mail: bool,
 }
 
 impl LinkConfig {
@@ -75,6 +79,7 @@ impl LinkConfig {
             chain_stall: DEFAULT_CHAIN_STALL,
             pin_chains: true,
             realtime: false,
+            mail: false,
         }
     }
 
@@ -140,6 +145,7 @@ impl DeathNotices {
 /// The world's reading end of one robot's command board. Fields drop in declaration order: entry, port, service.
 struct CommandBoard {
     entry: EntryHandle<ipc::Service, u32, ActuatorCommand>,
+    outbox: Option<EntryHandle<ipc::Service, u32, Mailbox>>,
     _reader: Reader<ipc::Service, u32>,
     _board: Board,
     generation: u32,
@@ -150,8 +156,9 @@ impl CommandBoard {
         node: &Node<ipc::Service>,
         robot: u32,
         generation: u32,
+        mail: bool,
     ) -> Result<CommandBoard, TransportError> {
-        let board = services::create_command_board(node, robot, generation)?;
+        let board = services::create_command_board(node, robot, generation, mail)?;
         let reader = board
             .reader_builder()
             .create()
@@ -159,8 +166,16 @@ impl CommandBoard {
         let entry = reader
             .entry::<ActuatorCommand>(&COMMAND_KEY)
             .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
+        let outbox = mail
+            .then(|| {
+                reader.entry::<Mailbox>(&OUTBOX_KEY).map_err(|e| {
+                    TransportError::iceoryx(format!("robot {robot}'s outbox entry"), e)
+                })
+            })
+            .transpose()?;
         Ok(CommandBoard {
             entry,
+            outbox,
             _reader: reader,
             _board: board,
             generation,
@@ -168,11 +183,20 @@ impl CommandBoard {
     }
 }
 
-/// The world's iceoryx2 ports: one frame-board entry and one command board per robot, indexed by robot.
-/// Entry handles keep their ports and services alive; the other fields are only held, in drop order.
+/// The world's writing end of the inbox board (runs with mail only). Fields drop in declaration order.
+struct InboxBoard {
+    entries: Vec<EntryHandleMut<ipc::Service, u32, Mailbox>>,
+    _writer: Writer<ipc::Service, u32>,
+    _board: Board,
+}
+
+/// The world's iceoryx2 ports: one frame-board entry and one command board per robot, indexed by robot, and
+/// the inbox board in runs with mail. Entry handles keep their ports and services alive; the other fields are
+/// only held, in drop order.
 struct Boards {
     frame_entries: Vec<EntryHandleMut<ipc::Service, u32, SensorFrame>>,
     commands: Vec<CommandBoard>,
+    inboxes: Option<InboxBoard>,
     _frame_writer: Writer<ipc::Service, u32>,
     _frame_board: Board,
 }
@@ -195,6 +219,8 @@ pub struct WorldLink {
     node: Node<ipc::Service>,
     /// The CPU of each chain's agents, when they pin themselves ([`LinkConfig::pin_chains`]); empty otherwise.
     chain_cpus: Vec<usize>,
+    /// Messages posted to each robot's inbox for the next tick ([`WorldLink::post`]); its frame says how many.
+    posted: Vec<u8>,
 }
 
 impl WorldLink {
@@ -208,7 +234,7 @@ impl WorldLink {
             });
         }
         let node = services::node(run, "world")?;
-        let boards = Self::create_boards(&node, robots)?;
+        let boards = Self::create_boards(&node, robots, config.mail)?;
         let cleaner = Cleaner::start(run.iceoryx_config()?)?;
         // Last, so that a failure above leaves no sync block behind (iceoryx2 removes its own resources on drop).
         let sync = Arc::new(SyncBlock::create(
@@ -218,6 +244,7 @@ impl WorldLink {
             AgentPlacement {
                 pin_chains: config.pin_chains,
                 realtime: config.realtime,
+                mail: config.mail,
             },
         )?);
         let chain_cpus = if config.pin_chains {
@@ -243,10 +270,15 @@ impl WorldLink {
             node,
             config,
             chain_cpus,
+            posted: vec![0; robots as usize],
         })
     }
 
-    fn create_boards(node: &Node<ipc::Service>, robots: u32) -> Result<Boards, TransportError> {
+    fn create_boards(
+        node: &Node<ipc::Service>,
+        robots: u32,
+        mail: bool,
+    ) -> Result<Boards, TransportError> {
         let frame_board = services::create_frame_board(node, robots)?;
         let frame_writer = frame_board
             .writer_builder()
@@ -260,13 +292,40 @@ impl WorldLink {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let commands = (0..robots)
-            .map(|robot| CommandBoard::create(node, robot, 0))
+            .map(|robot| CommandBoard::create(node, robot, 0, mail))
             .collect::<Result<Vec<_>, _>>()?;
+        let inboxes = mail
+            .then(|| Self::create_inboxes(node, robots))
+            .transpose()?;
         Ok(Boards {
             frame_entries,
             commands,
+            inboxes,
             _frame_writer: frame_writer,
             _frame_board: frame_board,
+        })
+    }
+
+    fn create_inboxes(
+        node: &Node<ipc::Service>,
+        robots: u32,
+    ) -> Result<InboxBoard, TransportError> {
+        let board = services::create_inbox_board(node, robots)?;
+        let writer = board
+            .writer_builder()
+            .create()
+            .map_err(|e| TransportError::iceoryx("writing the inbox board", e))?;
+        let entries = (0..robots)
+            .map(|robot| {
+                writer
+                    .entry::<Mailbox>(&robot)
+                    .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s inbox entry"), e))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(InboxBoard {
+            entries,
+            _writer: writer,
+            _board: board,
         })
     }
 
@@ -387,6 +446,9 @@ impl WorldLink {
             let robots = chain.start as usize..chain.end as usize;
             let frames = &mut self.frames[robots.clone()];
             SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
+            for (frame, &posted) in frames.iter_mut().zip(&self.posted[robots.clone()]) {
+                frame.inbox_len = posted;
+            }
             for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
                 entry.update_with_copy(*frame);
             }
@@ -404,8 +466,41 @@ impl WorldLink {
             tracing::debug!(tick, "tick deadline passed with answers missing");
         }
         let outcome = self.collect(tick);
+        self.posted.fill(0);
         self.cleanup_if_due(tick);
         Ok(outcome)
+    }
+
+    /// Puts `inbox` into `robot`'s inbox for the next tick, whose frame then says how many messages wait
+    /// (`inbox.tick` and `inbox.owner` are set here). Without mail (see [`LinkConfig::mail`]), or for a robot out
+    /// of range, nothing is posted and the call says so.
+    pub fn post(&mut self, robot: u32, inbox: &mut Mailbox) -> bool {
+        let Some(entry) = self
+            .boards
+            .inboxes
+            .as_ref()
+            .and_then(|inboxes| inboxes.entries.get(robot as usize))
+        else {
+            return false;
+        };
+        inbox.tick = self.tick + 1;
+        inbox.owner = robot;
+        entry.update_with_copy(*inbox);
+        self.posted[robot as usize] = inbox.messages().len() as u8;
+        true
+    }
+
+    /// The messages `robot` sent in the last tick, read from its outbox; `None` when it did not answer, sent
+    /// nothing, or its outbox does not belong to the tick (an agent that died between writing its outbox and
+    /// its command).
+    pub fn outbox(&self, robot: u32) -> Option<Mailbox> {
+        let command = self.command(robot)?;
+        if command.outbox_len == 0 {
+            return None;
+        }
+        let board = self.boards.commands.get(robot as usize)?;
+        let outbox = *board.outbox.as_ref()?.get();
+        (outbox.tick == command.tick && outbox.owner == robot).then_some(outbox)
     }
 
     /// Reads each robot's command for `tick` from its own board into its slot.
@@ -455,7 +550,7 @@ impl WorldLink {
                 continue;
             }
             let generation = board.generation + 1;
-            match CommandBoard::create(&self.node, robot, generation) {
+            match CommandBoard::create(&self.node, robot, generation, self.config.mail) {
                 Ok(fresh) => {
                     *board = fresh;
                     sync.publish_board(robot, generation);

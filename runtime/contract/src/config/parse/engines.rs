@@ -1,9 +1,12 @@
-//! `<physics_engines>` (one `dynamics2d`) and `<media>` (`led`, `range_and_bearing`, our `pheromone`).
+//! `<physics_engines>` (one `dynamics2d`) and `<media>` (`led`, `range_and_bearing`, our `pheromone` and
+//! `messages`).
 
 use super::Ctx;
 use crate::config::model::{
-    Element, Location, Media, Medium, PheromoneChannel, PheromoneField, PhysicsEngine,
+    Element, Location, Media, Medium, MessagesMedium, PheromoneChannel, PheromoneField,
+    PhysicsEngine,
 };
+use crate::mail::{MAIL_PAYLOAD_BYTES, MAILBOX_CAPACITY};
 use crate::messages::PHEROMONE_CHANNELS;
 
 const ENGINES: &[&str] = &["dynamics2d"];
@@ -69,7 +72,7 @@ fn dynamics2d(ctx: &mut Ctx, el: &Element) -> Option<PhysicsEngine> {
     })
 }
 
-const MEDIA: &[&str] = &["led", "range_and_bearing", "pheromone"];
+const MEDIA: &[&str] = &["led", "range_and_bearing", "pheromone", "messages"];
 /// ARGoS media we recognise but do not implement.
 const UNSUPPORTED_MEDIA: &[&str] = &["directional_led", "simple_radio", "tag", "radio"];
 
@@ -130,11 +133,32 @@ pub(super) fn media(ctx: &mut Ctx, el: &Element) -> Media {
                 media.pheromone = Some(field);
                 id
             }
+            "messages" => {
+                if let Some(first) = &media.messages {
+                    ctx.error(
+                        child.location,
+                        format!(
+                            "a second <messages> medium (first at {}): only one is supported",
+                            first.location
+                        ),
+                        None,
+                    );
+                    continue;
+                }
+                let Some(medium) = messages(ctx, child) else {
+                    continue;
+                };
+                let id = medium.id.clone();
+                media.messages = Some(medium);
+                id
+            }
             name if UNSUPPORTED_MEDIA.contains(&name) => {
                 ctx.error(
                     child.location,
                     format!("medium <{name}> is not supported"),
-                    Some("supported media: led, range_and_bearing, pheromone".to_string()),
+                    Some(
+                        "supported media: led, range_and_bearing, pheromone, messages".to_string(),
+                    ),
                 );
                 continue;
             }
@@ -165,6 +189,54 @@ fn medium(ctx: &mut Ctx, el: &Element) -> Option<Medium> {
     Some(Medium {
         id,
         grid_size,
+        location: el.location,
+    })
+}
+
+/// Default of `<messages max_per_tick>`.
+const DEFAULT_MESSAGES_PER_TICK: u32 = 8;
+
+/// `<messages id range loss max_payload max_per_tick>`.
+fn messages(ctx: &mut Ctx, el: &Element) -> Option<MessagesMedium> {
+    ctx.unknown_attributes(el, &["id", "range", "loss", "max_payload", "max_per_tick"]);
+    for child in &el.children {
+        ctx.unknown_element(child, &el.name, &[]);
+    }
+    let id: Option<String> = ctx.required(el, "id");
+    let range = if el.attributes.contains_key("range") {
+        Some(ctx.positive(el, "range")?)
+    } else {
+        None
+    };
+    let loss: f64 = ctx.attr(el, "loss").unwrap_or(0.0);
+    let max_payload: u32 = ctx
+        .attr(el, "max_payload")
+        .unwrap_or(MAIL_PAYLOAD_BYTES as u32);
+    let max_per_tick: u32 = ctx
+        .attr(el, "max_per_tick")
+        .unwrap_or(DEFAULT_MESSAGES_PER_TICK);
+    let loss_ok = ctx.in_range(el, "loss", loss, 0.0, Some(1.0));
+    let payload_ok = ctx.in_range(
+        el,
+        "max_payload",
+        f64::from(max_payload),
+        1.0,
+        Some(MAIL_PAYLOAD_BYTES as f64),
+    );
+    let per_tick_ok = ctx.in_range(
+        el,
+        "max_per_tick",
+        f64::from(max_per_tick),
+        1.0,
+        Some(MAILBOX_CAPACITY as f64),
+    );
+    (loss_ok && payload_ok && per_tick_ok).then_some(())?;
+    Some(MessagesMedium {
+        id: id?,
+        range,
+        loss,
+        max_payload,
+        max_per_tick,
         location: el.location,
     })
 }
