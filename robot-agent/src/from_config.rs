@@ -1,7 +1,8 @@
 //! Choosing a robot's controller from a parsed experiment, with errors located in the `.argos` file.
 //!
 //! A robot's controller is the one its robot element names, found by the robot's index in the canonical order
-//! that the launcher, the world and the agents share (`Arena::robots`). The controller's `<params>` attributes
+//! that the launcher, the world and the agents share (`Experiment::participants`: the robots, then the
+//! coordinators, whose agents run their controllers the same way). The controller's `<params>` attributes
 //! (and its children's, as `child.attribute`) become the [`Params`] of its profile or native controller, and
 //! relative paths in them resolve against the configuration's folder.
 
@@ -13,30 +14,28 @@ use crate::control::{self, Control};
 use crate::controller::{self, Plan, Supervisors};
 use crate::params::Params;
 
-/// The controller of robot `robot` (its index in the canonical robot order, `Arena::robots`).
+/// The controller of participant `robot` (its index in the canonical order, `Experiment::participants`).
 pub fn controller_of(experiment: &Experiment, robot: u32) -> Result<&Controller, Diagnostic> {
     let file_level = Location { line: 0, column: 0 };
-    let robots = experiment.arena.robots();
-    let Some(entry) = robots.iter().find(|r| r.index == robot) else {
+    let participants = experiment.participants();
+    let Some(entry) = participants.iter().find(|r| r.index == robot) else {
         return Err(experiment.diagnostic(
             file_level,
             format!(
-                "there is no robot {robot}: the configuration has {} robots",
-                robots.len()
+                "there is no robot {robot}: the configuration has {} robots and coordinators",
+                participants.len()
             ),
         ));
     };
-    experiment
-        .controller(&entry.entity.controller)
-        .ok_or_else(|| {
-            experiment.diagnostic(
-                entry.entity.location,
-                format!(
-                    "robot {robot} (`{}`) names controller `{}`, which is not declared",
-                    entry.id, entry.entity.controller
-                ),
-            )
-        })
+    experiment.controller(entry.controller).ok_or_else(|| {
+        experiment.diagnostic(
+            entry.location,
+            format!(
+                "robot {robot} (`{}`) names controller `{}`, which is not declared",
+                entry.id, entry.controller
+            ),
+        )
+    })
 }
 
 /// The controller with id `id` (the launcher names it explicitly).

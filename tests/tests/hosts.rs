@@ -213,6 +213,33 @@ fn messages_between_robots_on_two_hosts_have_the_fates_they_have_on_one() {
 }
 
 #[test]
+fn a_coordinator_on_a_host_is_killed_restarted_and_answers_as_on_one_host() {
+    let (single, multi, hosts) =
+        run_single_and_on_two_hosts("configs/messages/coordinator.argos", &[]);
+    for file in ["messages.csv", "events.csv", "trajectory.csv"] {
+        assert!(
+            read(single.path(), file) == read(multi.path(), file),
+            "{file} of the two-host run differs from the single-host run with the same seed"
+        );
+    }
+    let placed: Vec<u64> = summary(multi.path())["hosts"]["hosts"]
+        .as_array()
+        .expect("hosts in the summary")
+        .iter()
+        .flat_map(|h| h["robots"].as_array().cloned().unwrap_or_default())
+        .filter_map(|r| r.as_u64())
+        .collect();
+    assert!(
+        placed.contains(&4),
+        "the coordinator runs on a host: {placed:?}"
+    );
+    let events = String::from_utf8(read(multi.path(), "events.csv")).expect("UTF-8");
+    assert!(events.contains("20,4,central,fault:kill"), "{events}");
+    assert!(events.contains("22,4,central,fault:up"), "{events}");
+    hosts.stop_and_check_clean();
+}
+
+#[test]
 fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     let (_, _, hosts) = single_and_two_hosts(&[]);
     for (daemon, robot) in hosts.daemons.iter().zip([0, 5]) {

@@ -1,14 +1,25 @@
-//! Addressed messages between robots, end to end with real processes: the world decides every message's fate by
-//! the `<messages>` medium, records it in `messages.csv`, and delivers what passes to the recipient's agent in the
-//! next tick. The shipped example `configs/messages/talk.argos` has a robot of each kind of trouble (see its
-//! header). Across hosts: `hosts::messages_between_robots_on_two_hosts_have_the_fates_they_have_on_one`.
+//! Addressed messages between robots and coordinators, end to end with real processes: the world decides every
+//! message's fate by the `<messages>` medium, records it in `messages.csv`, and delivers what passes to the
+//! recipient's agent in the next tick. The shipped example `configs/messages/talk.argos` has a robot of each kind
+//! of trouble (see its header); `configs/messages/coordinator.argos` has four robots reporting to a coordinator
+//! that the schedule kills and restarts. Across hosts:
+//! `hosts::messages_between_robots_on_two_hosts_have_the_fates_they_have_on_one`.
 
 use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
-use swarm_system_tests::{assert_clean, swarm, workspace_file};
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+use swarm_system_tests::{
+    assert_clean, assert_nothing_left, remove_run_leftovers, spawn_swarm, swarm, swarm_ctl,
+    workspace_file,
+};
 
 const TALK: &str = "configs/messages/talk.argos";
+const COORDINATOR: &str = "configs/messages/coordinator.argos";
+/// The coordinator's participant index in `COORDINATOR`: after the four robots.
+const CENTRAL: u32 = 4;
 
 /// One row of `messages.csv`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -21,7 +32,11 @@ struct Row {
 }
 
 fn run(out: &Path, extra: &[&str]) {
-    let config = workspace_file(TALK).display().to_string();
+    run_config(TALK, out, extra);
+}
+
+fn run_config(config: &str, out: &Path, extra: &[&str]) {
+    let config = workspace_file(config).display().to_string();
     let out = out.display().to_string();
     let mut args = vec!["run", &config, "--out", &out, "--no-progress"];
     args.extend_from_slice(extra);
@@ -34,9 +49,11 @@ fn run(out: &Path, extra: &[&str]) {
     assert_clean(&outcome);
 }
 
+/// The rows of `messages.csv` (of a live run: the lines written so far, up to the last whole one).
 fn messages(out: &Path) -> Vec<Row> {
     let text = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
-    let mut lines = text.lines();
+    let whole = text.rfind('\n').map_or("", |end| &text[..end]);
+    let mut lines = whole.lines();
     assert_eq!(
         lines.next(),
         Some("tick,from,to,address,bytes,outcome,reason")
@@ -142,4 +159,174 @@ fn the_same_seed_gives_the_same_messages_and_another_seed_other_losses() {
     assert!(!a.is_empty());
     assert_eq!(a, b, "two runs with the same seed");
     assert_ne!(a, c, "the loss draws of another seed");
+}
+
+fn text(out: &Path, file: &str) -> String {
+    std::fs::read_to_string(out.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+#[test]
+fn a_coordinator_answers_robots_and_the_run_goes_on_while_it_is_killed_and_restarted() {
+    let runs: Vec<tempfile::TempDir> = (0..2)
+        .map(|_| tempfile::tempdir().expect("a temporary directory"))
+        .collect();
+    for out in &runs {
+        run_config(COORDINATOR, out.path(), &[]);
+    }
+    let out = runs[0].path();
+    let summary: serde_json::Value =
+        serde_json::from_str(&text(out, "summary.json")).expect("summary.json");
+    assert_eq!(summary["robots"], 4);
+    assert_eq!(summary["coordinators"][0]["id"], "central");
+    assert_eq!(summary["coordinators"][0]["index"], CENTRAL);
+    let fault = &summary["faults"][0];
+    assert_eq!(
+        (&fault["robot"], &fault["restarted"], &fault["rejoin_tick"]),
+        (&CENTRAL.into(), &true.into(), &22.into()),
+        "{fault}"
+    );
+    let events = text(out, "events.csv");
+    assert!(events.contains("20,4,central,fault:kill\n"), "{events}");
+    assert!(events.contains("22,4,central,fault:up\n"), "{events}");
+    let trajectory = text(out, "trajectory.csv");
+    assert!(
+        trajectory
+            .lines()
+            .skip(1)
+            .all(|l| l.split(',').nth(1) != Some("4")),
+        "a coordinator has no body, so no trajectory"
+    );
+    let rows = messages(out);
+    for tick in 1..=50u64 {
+        let reports: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.tick == tick && r.to == Some(CENTRAL))
+            .collect();
+        let down = (20..=21).contains(&tick);
+        assert_eq!(reports.len(), 4, "tick {tick}");
+        assert!(
+            reports.iter().all(|r| if down {
+                r.reason == "recipient_down"
+            } else {
+                r.outcome == "delivered"
+            }),
+            "tick {tick}: {reports:?}"
+        );
+        // It answers in the tick after a report reached it: not while it is down, nor in its first tick back.
+        let answers = rows
+            .iter()
+            .filter(|r| r.tick == tick && r.from == CENTRAL && r.outcome == "delivered")
+            .count();
+        let answering = tick >= 2 && !(20..=22).contains(&tick);
+        assert_eq!(answers, if answering { 4 } else { 0 }, "tick {tick}");
+    }
+    for (file, what) in [("messages.csv", "messages"), ("events.csv", "events")] {
+        assert_eq!(
+            text(runs[0].path(), file),
+            text(runs[1].path(), file),
+            "the {what} of two runs with the same seed"
+        );
+    }
+}
+
+#[test]
+fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let out_arg = out.path().display().to_string();
+    let config = workspace_file(COORDINATOR).display().to_string();
+    let mut child = spawn_swarm(&[
+        "run",
+        &config,
+        "--no-progress",
+        "--real-time",
+        "--ticks",
+        "100000",
+        "--tick-deadline-ms",
+        "100",
+        "--out",
+        &out_arg,
+    ]);
+    let pid = child.id();
+    let mut log = BufReader::new(child.stderr.take().expect("stderr is piped"));
+    let mut wait_for = |needle: &str| -> String {
+        let mut line = String::new();
+        loop {
+            line.clear();
+            let read = log.read_line(&mut line).expect("the launcher's log");
+            assert!(read > 0, "the launcher ended before `{needle}`");
+            if line.contains(needle) {
+                return line.clone();
+            }
+        }
+    };
+    // The schedule's kill at tick 20 and the restart come first.
+    wait_for("robot 4 takes part again from tick 22");
+    let list = swarm_ctl(out.path(), &["list"]);
+    assert!(
+        list.lines()
+            .any(|l| l.starts_with("robot 4 central pid ") && l.contains(" running ")),
+        "{list}"
+    );
+    assert_eq!(swarm_ctl(out.path(), &["freeze", "4"]), "robot 4 frozen\n");
+    assert_eq!(swarm_ctl(out.path(), &["thaw", "4"]), "robot 4 thawed\n");
+    assert_eq!(swarm_ctl(out.path(), &["kill", "4"]), "robot 4 killed\n");
+    let back = wait_for("robot 4 takes part again from tick");
+    let back: u64 = back
+        .trim_end()
+        .rsplit(' ')
+        .next()
+        .and_then(|t| t.parse().ok())
+        .expect("a tick");
+    // The run writes messages.csv tick by tick: wait until the coordinator has answered after its return.
+    let answered_again = |rows: &[Row]| {
+        rows.iter()
+            .any(|r| r.from == CENTRAL && r.outcome == "delivered" && r.tick > back)
+    };
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !answered_again(&messages(out.path())) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the coordinator never answered after its return at tick {back}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
+    let mut rest = String::new();
+    while log.read_line(&mut rest).unwrap_or(0) > 0 {}
+    let status = child.wait().expect("the launcher exits");
+    assert_eq!(status.code(), Some(130), "{rest}");
+    assert_nothing_left(pid);
+    remove_run_leftovers(&format!("sw{pid:x}-"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&text(out.path(), "summary.json")).expect("summary.json");
+    let faults: Vec<(String, u64, bool)> = summary["faults"]
+        .as_array()
+        .expect("faults")
+        .iter()
+        .map(|f| {
+            (
+                f["what"].as_str().unwrap_or_default().to_owned(),
+                f["robot"].as_u64().unwrap_or(u64::MAX),
+                f["restarted"].as_bool().unwrap_or(false),
+            )
+        })
+        .collect();
+    for what in ["ctl-freeze", "ctl-thaw", "ctl-kill"] {
+        assert!(
+            faults.iter().any(|(w, robot, _)| w == what && *robot == 4),
+            "{what} of the coordinator in {faults:?}"
+        );
+    }
+    assert!(
+        faults
+            .iter()
+            .any(|(w, _, restarted)| w == "ctl-kill" && *restarted),
+        "{faults:?}"
+    );
+    assert!(
+        messages(out.path())
+            .iter()
+            .any(|r| r.to == Some(CENTRAL) && r.reason == "recipient_down" && r.tick > 22),
+        "reports are dropped while the coordinator is away"
+    );
 }

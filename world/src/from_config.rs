@@ -318,6 +318,9 @@ pub fn build(
     if let Some(medium) = &exp.media.messages {
         b.messages(medium);
     }
+    for coordinator in &exp.coordinators {
+        b.coordinator(&coordinator.id, &coordinator.controller);
+    }
 
     let mut occupied: Vec<Placed> = Vec::new();
     let mut rng = stream(seed, Purpose::Placement, 0);

@@ -52,6 +52,17 @@ pub struct WorldBuilder {
     seed: u64,
     loop_functions: Box<dyn LoopFunctions>,
     mail: Option<MailMedium>,
+    coordinators: Vec<Coordinator>,
+}
+
+/// A participant of the run without a body (`<coordinator>`): it takes part in the lockstep and talks through the
+/// messages medium, but the world simulates nothing of it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Coordinator {
+    /// Its id.
+    pub id: String,
+    /// Its controller's id.
+    pub controller: String,
 }
 
 impl WorldBuilder {
@@ -79,6 +90,7 @@ impl WorldBuilder {
             seed,
             loop_functions: Box::new(DefaultLoopFunctions),
             mail: None,
+            coordinators: Vec::new(),
         }
     }
 
@@ -249,6 +261,14 @@ impl WorldBuilder {
         self.mail = Some(MailMedium::new(medium, self.seed));
     }
 
+    /// Adds a coordinator: participant `robots + k` of the run for the k-th one added.
+    pub fn coordinator(&mut self, id: &str, controller: &str) {
+        self.coordinators.push(Coordinator {
+            id: id.to_owned(),
+            controller: controller.to_owned(),
+        });
+    }
+
     /// Sets the loop functions (the default ones record basic metrics only).
     pub fn loop_functions(&mut self, loop_functions: Box<dyn LoopFunctions>) {
         self.loop_functions = loop_functions;
@@ -269,6 +289,7 @@ impl WorldBuilder {
             pending_gripper_events: Vec::new(),
             mail: self.mail,
             participants: Vec::new(),
+            coordinators: self.coordinators,
         };
         world.update_media();
         world
@@ -292,6 +313,8 @@ pub struct World {
     mail: Option<MailMedium>,
     /// Every participant's state for the messages medium, refilled each tick.
     participants: Vec<Participant>,
+    /// The participants after the robots, which have no body.
+    coordinators: Vec<Coordinator>,
 }
 
 impl World {
@@ -333,6 +356,16 @@ impl World {
     pub fn is_finished(&self) -> bool {
         self.max_ticks.is_some_and(|m| self.arena.tick >= m)
             || self.loop_functions.is_finished(&self.arena)
+    }
+
+    /// The run's coordinators: participants `robot_count()..` in order.
+    pub fn coordinators(&self) -> &[Coordinator] {
+        &self.coordinators
+    }
+
+    /// Number of participants: the robots, then the coordinators.
+    pub fn participant_count(&self) -> usize {
+        self.arena.robots.len() + self.coordinators.len()
     }
 
     /// Whether the run has a messages medium.

@@ -123,13 +123,14 @@ pub fn follow_launcher(notices: Option<DeathNotices>) -> Receiver<WorldCommand> 
 }
 
 impl FaultDriver {
-    /// The driver of a run of `robots` robots with `schedule`, seeded with `seed`. Call it before any agent
-    /// can join: every robot starts without an agent in the transport (a death notice each), so a robot counts
-    /// as present only once its agent has connected, not merely claimed its slot.
+    /// The driver of `world`'s run with `schedule`, seeded with `seed`: `link.robots()` participants, of which
+    /// the world's robots come first (random picks choose among those, never a coordinator). Call it before any
+    /// agent can join: every participant starts without an agent in the transport (a death notice each), so it
+    /// counts as present only once its agent has connected, not merely claimed its slot.
     pub fn new(
         link: &Link,
+        world: &World,
         schedule: &FaultSchedule,
-        ticks_per_second: u32,
         seed: u64,
         commands: Receiver<WorldCommand>,
         out_dir: PathBuf,
@@ -141,9 +142,10 @@ impl FaultDriver {
                 local.mark_dead(robot)?;
             }
         }
-        let mut plan = FaultPlan::new(schedule, ticks_per_second, seed);
+        let bodies = world.robot_count();
+        let mut plan = FaultPlan::new(schedule, world.arena.ticks_per_second, seed);
         let mut due = Vec::new();
-        plan.due(0, &vec![true; robots], &mut due);
+        plan.due(0, &vec![true; bodies], &mut due);
         let startup_kills = due
             .iter()
             .filter(|a| a.kind == FaultKind::Kill)
@@ -163,7 +165,7 @@ impl FaultDriver {
             news: Vec::new(),
             host_kills: Vec::new(),
             due,
-            alive_mask: vec![true; robots],
+            alive_mask: vec![true; bodies],
             out_dir,
             join_timeout: limits.join_timeout(),
             apply_timeout: limits.fault_apply_timeout(),

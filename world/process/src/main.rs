@@ -90,15 +90,17 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     let mut world = World::new(&experiment, args.seed)?;
     // The launcher resolved the run's length (`--ticks`, else the experiment's `length`): it wins both ways.
     world.set_max_ticks((args.ticks > 0).then_some(args.ticks));
-    let robots = world.robot_count();
+    // The transport, the fault schedule and the records count every participant: the robots, then the
+    // coordinators; the world simulates the robots' bodies only.
+    let bodies = world.robot_count();
+    let robots = world.participant_count();
     swarm_contract::process::open_files::ensure(robots as u32)?;
     let schedule = FaultSchedule::for_run(&experiment, &args.faults, robots as u32)?;
     world.set_dead_bodies(schedule.dead_bodies);
     let roster: Vec<(String, String)> = experiment
-        .arena
-        .robots()
+        .participants()
         .into_iter()
-        .map(|r| (r.id, r.entity.controller.clone()))
+        .map(|p| (p.id, p.controller.to_owned()))
         .collect();
 
     let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;
@@ -132,8 +134,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     };
     let mut faults = FaultDriver::new(
         &link,
+        &world,
         &schedule,
-        experiment.framework.ticks_per_second,
         args.seed,
         launcher,
         args.out.clone(),
@@ -184,7 +186,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 None => has_command[robot] = false,
             }
         }
-        world.act_and_step(&commands, &has_command);
+        world.act_and_step(&commands[..bodies], &has_command[..bodies]);
         if let Some(post) = &mut post {
             post.after_tick(&mut link, &mut world, &faults, &mut recorder);
         }

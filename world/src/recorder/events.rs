@@ -14,6 +14,7 @@ use swarm_contract::run_dir::{EVENT_TABLES_FILE, EVENTS_FILE};
 use super::csv_line::CsvLine;
 use crate::arena::Arena;
 use crate::error::WorldError;
+use crate::world::Coordinator;
 
 /// One row of `events.csv`, before formatting.
 #[derive(Clone, Copy, Debug)]
@@ -42,14 +43,19 @@ pub enum EventRow {
 pub struct EventsWriter {
     path: PathBuf,
     out: BufWriter<File>,
-    /// Per robot: its id and its controller's event names by event id.
+    /// Per participant (robots, then coordinators): its id and its controller's event names by event id.
     robots: Vec<(String, Vec<String>)>,
 }
 
 impl EventsWriter {
-    /// Creates `events.csv` in `dir` for the arena's robots, naming events from the event tables the launcher
-    /// left there (a robot whose controller has no table, or a run without tables, gets numeric event names).
-    pub fn create(dir: &Path, arena: &Arena) -> Result<EventsWriter, WorldError> {
+    /// Creates `events.csv` in `dir` for the arena's robots and the run's `coordinators` (the participants after
+    /// the robots), naming events from the event tables the launcher left there (a controller without a table,
+    /// or a run without tables, gets numeric event names).
+    pub fn create(
+        dir: &Path,
+        arena: &Arena,
+        coordinators: &[Coordinator],
+    ) -> Result<EventsWriter, WorldError> {
         let tables_path = dir.join(EVENT_TABLES_FILE);
         let tables: BTreeMap<String, Vec<String>> = match std::fs::read_to_string(&tables_path) {
             Ok(text) => serde_json::from_str(&text).map_err(|e| WorldError::Io {
@@ -65,15 +71,17 @@ impl EventsWriter {
         };
         let mut out = BufWriter::new(File::create(&path).map_err(io_error)?);
         writeln!(out, "tick,robot,robot_id,event").map_err(io_error)?;
+        let named = |id: &str, controller: &str| {
+            (
+                id.to_owned(),
+                tables.get(controller).cloned().unwrap_or_default(),
+            )
+        };
         let robots = arena
             .robots
             .iter()
-            .map(|r| {
-                (
-                    r.name.clone(),
-                    tables.get(&r.controller).cloned().unwrap_or_default(),
-                )
-            })
+            .map(|r| named(&r.name, &r.controller))
+            .chain(coordinators.iter().map(|c| named(&c.id, &c.controller)))
             .collect();
         Ok(EventsWriter { path, out, robots })
     }

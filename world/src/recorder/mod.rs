@@ -71,7 +71,7 @@ impl Recorder {
             source,
         })?;
         let files = RecordFiles {
-            events: EventsWriter::create(dir, &world.arena)?,
+            events: EventsWriter::create(dir, &world.arena, world.coordinators())?,
             trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
             messages: world
                 .has_mail()
@@ -169,8 +169,8 @@ impl Recorder {
 
     /// Writes the rest of `trajectory.csv` and `events.csv`, a snapshot of the final state (unless that tick
     /// was drawn already), then `summary.json`: the metrics of the loop functions under `metrics`, the run
-    /// facts, the final pose of every movable box and cylinder under `movable_objects`, and `extra` merged in at
-    /// the top level. Returns the summary's path.
+    /// facts, the final pose of every movable box and cylinder under `movable_objects`, the participants without
+    /// a body under `coordinators` (index, id, controller), and `extra` merged in at the top level. Returns the summary's path.
     ///
     /// The final snapshot is drawn here rather than in the last tick: drawing it there counted as tick time and
     /// made the last tick of a 2,000-robot real-time run 50 ms late.
@@ -196,10 +196,15 @@ impl Recorder {
                 })
             })
             .collect();
+        let coordinators: Vec<serde_json::Value> = (world.robot_count()..)
+            .zip(world.coordinators())
+            .map(|(index, c)| serde_json::json!({"index": index, "id": c.id, "controller": c.controller}))
+            .collect();
         let mut summary = serde_json::json!({
             "ticks": world.tick(),
             "ticks_per_second": world.arena.ticks_per_second,
             "robots": world.robot_count(),
+            "coordinators": coordinators,
             "metrics": world.metrics(),
             "movable_objects": movable,
         });

@@ -175,6 +175,7 @@ pub fn thesis_example() -> Experiment {
             location: at(66),
         },
         media: Media::default(),
+        coordinators: Vec::new(),
         faults: Default::default(),
     }
 }

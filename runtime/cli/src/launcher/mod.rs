@@ -240,8 +240,10 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     };
     let mut limits = experiment.framework.limits;
     limits.apply(&options.limits)?;
-    let roster = experiment.arena.robots();
-    if roster.is_empty() {
+    // Every process of the run besides the world: the robots, then the coordinators.
+    let roster = experiment.participants();
+    let bodies = roster.iter().filter(|p| p.robot.is_some()).count();
+    if bodies == 0 {
         return Err(LaunchError::NoRobots {
             path: options.config.clone(),
         });
@@ -301,11 +303,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let ticks_per_second = experiment.framework.ticks_per_second;
     write_configuration_as_run(options, &experiment, &config, seed, &out_dir)?;
     let mut startup = Vec::new();
-    FaultPlan::new(&schedule, ticks_per_second, seed).due(
-        0,
-        &vec![true; roster.len()],
-        &mut startup,
-    );
+    // Random picks choose among robots, never coordinators.
+    FaultPlan::new(&schedule, ticks_per_second, seed).due(0, &vec![true; bodies], &mut startup);
     tracing::info!(robots, seed, ticks, out = %out_dir.display(), run = spec.name(), "starting");
 
     let compiled = check_controllers(
@@ -393,12 +392,8 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .iter()
             .map(|r| {
                 RobotEntry::new(
-                    r.entity.controller.clone(),
-                    RestartTracker::new(
-                        schedule
-                            .restart_rule(r.index, &r.entity.controller)
-                            .cloned(),
-                    ),
+                    r.controller.to_owned(),
+                    RestartTracker::new(schedule.restart_rule(r.index, r.controller).cloned()),
                 )
             })
             .collect(),
@@ -432,17 +427,28 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         supervision.children.kill_all();
         supervision.progress.finish_and_clear();
         if matches!(error, LaunchError::WorldDied { .. }) {
-            let complete = records::trim_to_complete_ticks(&out_dir, robots)
+            let complete = records::trim_to_complete_ticks(&out_dir, bodies as u32)
                 .map_err(io("cutting the records back to the last complete tick"))?;
-            let report =
-                supervision.report(seed, robots, world_pid, agent_pids, complete.unwrap_or(0));
+            let report = supervision.report(
+                seed,
+                bodies as u32,
+                world_pid,
+                agent_pids,
+                complete.unwrap_or(0),
+            );
             complete_summary(&out_dir, &report, &provenance, Some(&error.to_string()))?;
         }
         return Err(error);
     }
     supervision.collect_agents();
     supervision.progress.finish_and_clear();
-    let report = supervision.report(seed, robots, world_pid, agent_pids, supervision.last_tick);
+    let report = supervision.report(
+        seed,
+        bodies as u32,
+        world_pid,
+        agent_pids,
+        supervision.last_tick,
+    );
     if let Some(reason) = complete_summary(&out_dir, &report, &provenance, None)? {
         return Err(LaunchError::StoppedEarly {
             ticks: report.ticks,
@@ -464,7 +470,7 @@ fn check_controllers(
     config: &Path,
     seed: u64,
     robots: Option<u32>,
-    roster: &[swarm_contract::config::Robot<'_>],
+    roster: &[swarm_contract::config::Participant<'_>],
     out_dir: &Path,
 ) -> Result<HashMap<String, PathBuf>, LaunchError> {
     let compiled_dir = out_dir.join(COMPILED_SUPERVISORS_DIR);
@@ -473,7 +479,7 @@ fn check_controllers(
     let mut compiled = HashMap::new();
     let mut tables = serde_json::Map::new();
     for robot in roster {
-        let controller = &robot.entity.controller;
+        let controller = robot.controller;
         if tables.contains_key(controller) {
             continue;
         }
@@ -508,10 +514,10 @@ fn check_controllers(
             tracing::warn!("{warning}");
         }
         let names: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap_or_default();
-        tables.insert(controller.clone(), names);
+        tables.insert(controller.to_owned(), names);
         // Native controllers have no supervisors: no file, and their agents get no flag.
         if compiled_file.is_file() {
-            compiled.insert(controller.clone(), compiled_file);
+            compiled.insert(controller.to_owned(), compiled_file);
         }
     }
     let path = out_dir.join(EVENT_TABLES_FILE);

@@ -118,12 +118,65 @@ pub struct Experiment {
     pub physics_engine: PhysicsEngine,
     /// `<media>`: LED, range-and-bearing and pheromone media.
     pub media: Media,
+    /// `<coordinators>` (our extension): processes of the run that are not robots, in file order.
+    pub coordinators: Vec<Coordinator>,
     /// `<faults>`: the fault schedule and restart rules the configuration itself gives (empty without the
     /// section); a run adds `--fault` texts with [`FaultSchedule::for_run`](super::faults::FaultSchedule::for_run).
     pub faults: super::faults::FaultSchedule,
 }
 
+/// `<coordinator id>` with `<controller config>`: a process of the run without a body, e.g. a central store or an
+/// allocator. It runs its controller in lockstep with the world like a robot's agent, talks to robots through
+/// the `<messages>` medium, and faults apply to it (docs/messages.md).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coordinator {
+    /// `id`, unique among robots and coordinators.
+    pub id: String,
+    /// The controller's id in `<controllers>`.
+    pub controller: String,
+    /// Where the element is.
+    pub location: Location,
+}
+
+/// A process of a run that takes part in the lockstep: a robot, or a coordinator.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Participant<'a> {
+    /// Its index in the run: the robots first (`Arena::robots` order), then the coordinators in file order.
+    pub index: u32,
+    /// Its id.
+    pub id: String,
+    /// Its controller's id.
+    pub controller: &'a str,
+    /// The robot's element; `None` for a coordinator.
+    pub robot: Option<&'a RobotEntity>,
+    /// Where its element is.
+    pub location: Location,
+}
+
 impl Experiment {
+    /// Every participant of the run in index order: the robots, then the coordinators.
+    pub fn participants(&self) -> Vec<Participant<'_>> {
+        let robots = self.arena.robots();
+        let first_coordinator = robots.len() as u32;
+        let robots = robots.into_iter().map(|r| Participant {
+            index: r.index,
+            id: r.id,
+            controller: r.entity.controller.as_str(),
+            robot: Some(r.entity),
+            location: r.entity.location,
+        });
+        let coordinators = (first_coordinator..)
+            .zip(&self.coordinators)
+            .map(|(index, c)| Participant {
+                index,
+                id: c.id.clone(),
+                controller: c.controller.as_str(),
+                robot: None,
+                location: c.location,
+            });
+        robots.chain(coordinators).collect()
+    }
+
     /// The controller with the given `id`, if declared.
     pub fn controller(&self, id: &str) -> Option<&Controller> {
         self.controllers.iter().find(|c| c.id == id)

@@ -466,8 +466,26 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let camera_aperture_deg: Option<f64> = ctx.attr(el, "omnidirectional_camera_aperture");
     let aperture_ok = camera_aperture_deg
         .is_none_or(|a| ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0)));
+    let controller = controller_ref(ctx, el);
+    (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok && range_finder_ok)
+        .then_some(())?;
+    Some(RobotEntity {
+        kind,
+        id: id?,
+        controller: controller?,
+        rab_range,
+        rab_data_size,
+        camera_aperture_deg,
+        range_finder_range: range_finder_range.flatten(),
+        shape,
+        location: el.location,
+    })
+}
+
+/// The one `<controller config="id"/>` child of a robot or coordinator element: the controller's id.
+pub(super) fn controller_ref(ctx: &mut Ctx, el: &Element) -> Option<String> {
     let mut controllers = el.children.iter().filter(|c| c.name == "controller");
-    let controller = match (controllers.next(), controllers.next()) {
+    match (controllers.next(), controllers.next()) {
         (Some(c), None) => {
             ctx.unknown_attributes(c, &["config"]);
             ctx.required::<String>(c, "config")
@@ -487,20 +505,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
             );
             None
         }
-    };
-    (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok && range_finder_ok)
-        .then_some(())?;
-    Some(RobotEntity {
-        kind,
-        id: id?,
-        controller: controller?,
-        rab_range,
-        rab_data_size,
-        camera_aperture_deg,
-        range_finder_range: range_finder_range.flatten(),
-        shape,
-        location: el.location,
-    })
+    }
 }
 
 fn light_pose(ctx: &mut Ctx, el: &Element, placed: bool) -> Option<Pose> {

@@ -14,6 +14,7 @@ pub(super) fn run(ctx: &mut Ctx, experiment: &Experiment) {
     media_references(ctx, experiment);
     controller_references(ctx, experiment);
     unique_ids(ctx, experiment);
+    coordinator_references(ctx, experiment);
     inside_arena(ctx, &experiment.arena);
 }
 
@@ -191,6 +192,45 @@ fn controller_references(ctx: &mut Ctx, experiment: &Experiment) {
                     controller.id
                 ),
                 Some("use the generic name (e.g. proximity, light, ground) or a controller for this robot".into()),
+            );
+        }
+    }
+}
+
+/// Every coordinator's controller is declared, and no coordinator shares a robot's id.
+fn coordinator_references(ctx: &mut Ctx, experiment: &Experiment) {
+    if experiment.coordinators.is_empty() {
+        return;
+    }
+    let robot_ids: HashSet<String> = experiment
+        .arena
+        .robots()
+        .into_iter()
+        .map(|r| r.id)
+        .collect();
+    for coordinator in &experiment.coordinators {
+        if experiment.controller(&coordinator.controller).is_none() {
+            let hint = did_you_mean(
+                &coordinator.controller,
+                experiment.controllers.iter().map(|c| c.id.as_str()),
+            );
+            ctx.error(
+                coordinator.location,
+                format!(
+                    "<coordinator> '{}' refers to controller '{}', which <controllers> does not declare",
+                    coordinator.id, coordinator.controller
+                ),
+                hint,
+            );
+        }
+        if robot_ids.contains(&coordinator.id) {
+            ctx.error(
+                coordinator.location,
+                format!(
+                    "duplicate id '{}': a robot of the arena already uses it",
+                    coordinator.id
+                ),
+                None,
             );
         }
     }

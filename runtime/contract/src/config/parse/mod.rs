@@ -8,6 +8,7 @@
 mod arena;
 mod checks;
 mod controllers;
+mod coordinators;
 mod engines;
 mod framework;
 
@@ -259,6 +260,7 @@ const SECTIONS: &[&str] = &[
     "physics_engines",
     "media",
     "visualization",
+    "coordinators",
     super::faults::SECTION,
 ];
 
@@ -325,6 +327,9 @@ fn experiment(ctx: &mut Ctx, root: &Element, path: &Path) -> Option<Experiment> 
     if let Some(el) = section("visualization") {
         visualization(ctx, el);
     }
+    let coordinators = section("coordinators")
+        .map(|el| coordinators::coordinators(ctx, el))
+        .unwrap_or_default();
     let faults = section(super::faults::SECTION)
         .map(|el| super::faults::read_section(ctx, el))
         .unwrap_or_default();
@@ -336,6 +341,7 @@ fn experiment(ctx: &mut Ctx, root: &Element, path: &Path) -> Option<Experiment> 
         arena: arena?,
         physics_engine: physics_engine?,
         media,
+        coordinators,
         faults,
     })
 }
