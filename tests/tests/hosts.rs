@@ -240,6 +240,25 @@ fn a_coordinator_on_a_host_is_killed_restarted_and_answers_as_on_one_host() {
 }
 
 #[test]
+fn scheduled_joins_on_two_hosts_give_the_single_host_records() {
+    let (single, multi, hosts) =
+        run_single_and_on_two_hosts("configs/joins/late_arrivals.argos", &[]);
+    for file in ["events.csv", "trajectory.csv"] {
+        assert!(
+            read(single.path(), file) == read(multi.path(), file),
+            "{file} of the two-host run differs from the single-host run with the same seed"
+        );
+    }
+    let events = String::from_utf8(read(multi.path(), "events.csv")).expect("UTF-8");
+    assert!(events.contains("30,4,late,join"), "{events}");
+    assert_eq!(
+        summary(single.path())["arrivals"],
+        summary(multi.path())["arrivals"]
+    );
+    hosts.stop_and_check_clean();
+}
+
+#[test]
 fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     let (_, _, hosts) = single_and_two_hosts(&[]);
     for (daemon, robot) in hosts.daemons.iter().zip([0, 5]) {

@@ -71,9 +71,12 @@ pub struct Robot {
     pub beacon: Rgb,
     /// Whether the robot is alive; a dead robot is an inert obstacle (or removed).
     pub alive: bool,
-    /// Whether its dead body has left the arena (`<faults dead_bodies="removed">`): it collides with nothing
-    /// and no sensor sees it.
+    /// Whether its dead body has left the arena (`<faults dead_bodies="removed">`), or the robot is not in the
+    /// arena at all (see `present`): it collides with nothing and no sensor sees it.
     pub removed: bool,
+    /// Whether the robot is in the run: false before it joins (`join_tick`, `join_time`, `spare`) and after it
+    /// left (`swarm ctl remove`). An absent robot is removed and not alive, whatever the faults do.
+    pub present: bool,
     /// Wheel speeds applied in the last tick, in cm/s, after clamping and noise.
     pub wheels: [f32; 2],
     /// The target the virtual gripper carries.

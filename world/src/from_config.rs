@@ -349,6 +349,18 @@ pub fn build(
     b.loop_functions(registry.create(params.as_ref())?);
     let mut world = b.build();
     world.set_max_ticks(exp.framework.max_ticks());
+    // Robots that join later wait outside the arena; they keep the pose they were given to join at.
+    for robot in exp.arena.robots() {
+        let id = crate::entities::RobotId(robot.index);
+        match robot.entity.arrival {
+            config::Arrival::Start => continue,
+            config::Arrival::At(at) => {
+                world.schedule_join(at.tick(exp.framework.ticks_per_second).max(1), id);
+            }
+            config::Arrival::Spare => {}
+        }
+        world.park(id);
+    }
     Ok(world)
 }
 

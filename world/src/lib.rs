@@ -8,6 +8,7 @@
 
 pub mod actuators;
 pub mod arena;
+pub mod arrivals;
 pub mod devices;
 pub mod distribute;
 pub mod entities;

@@ -143,6 +143,7 @@ impl WorldBuilder {
             beacon: swarm_contract::messages::Rgb::OFF,
             alive: true,
             removed: false,
+            present: true,
             wheels: [0.0; 2],
             carrying: None,
             gripper: GripperState::default(),
@@ -290,6 +291,7 @@ impl WorldBuilder {
             mail: self.mail,
             participants: Vec::new(),
             coordinators: self.coordinators,
+            join_schedule: Vec::new(),
         };
         world.update_media();
         world
@@ -315,6 +317,8 @@ pub struct World {
     participants: Vec<Participant>,
     /// The participants after the robots, which have no body.
     coordinators: Vec<Coordinator>,
+    /// The robots that join mid-run by schedule, with their tick, in tick order.
+    join_schedule: Vec<(u64, RobotId)>,
 }
 
 impl World {
@@ -440,7 +444,12 @@ impl World {
             self.pending_gripper_events
                 .extend(self.arena.gripper_events.drain(before..));
         }
-        let Some(r) = self.arena.robots.get_mut(robot.index()) else {
+        let Some(r) = self
+            .arena
+            .robots
+            .get_mut(robot.index())
+            .filter(|r| r.present)
+        else {
             return;
         };
         r.alive = alive;
@@ -463,6 +472,70 @@ impl World {
         }
         self.leds
             .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+    }
+
+    /// Schedules the absent `robot` to join at `tick` (see [`World::join`]; the world process carries it out).
+    pub fn schedule_join(&mut self, tick: u64, robot: RobotId) {
+        let at = self.join_schedule.partition_point(|&(t, _)| t <= tick);
+        self.join_schedule.insert(at, (tick, robot));
+    }
+
+    /// The robots that join mid-run by schedule, with their tick, in tick order.
+    pub fn join_schedule(&self) -> &[(u64, RobotId)] {
+        &self.join_schedule
+    }
+
+    /// Takes `robot` out of the arena: it is not in the run (before it joins, or after it left). Its body
+    /// collides with nothing, no sensor sees it, and its gripper lets go.
+    pub fn park(&mut self, robot: RobotId) {
+        self.set_alive(robot, false);
+        let Some(r) = self.arena.robots.get_mut(robot.index()) else {
+            return;
+        };
+        r.present = false;
+        r.removed = true;
+        self.arena.physics.set_enabled(r.handles, false);
+        self.scene.rebuild(
+            &self.arena.robots,
+            &self.arena.obstacles,
+            &self.arena.targets,
+        );
+        self.leds
+            .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+    }
+
+    /// Brings the absent `robot` into the arena at `wanted` (position and heading; default: the pose the
+    /// configuration gave it), or at the nearest free pose (see `arrivals`); returns where it is.
+    pub fn join(
+        &mut self,
+        robot: RobotId,
+        wanted: Option<(Vec2, f32)>,
+    ) -> Result<(Vec2, f32), crate::arrivals::PlaceRefused> {
+        let refused = |why: &str| Err(crate::arrivals::PlaceRefused(why.to_owned()));
+        let Some(r) = self.arena.robots.get(robot.index()) else {
+            return refused("no such robot");
+        };
+        if r.present {
+            return refused("it is in the arena already");
+        }
+        let (position, heading) = wanted.unwrap_or((r.position, r.heading));
+        let pose =
+            crate::arrivals::free_pose(&self.arena, robot, position, heading, r.body.radius)?;
+        let r = &mut self.arena.robots[robot.index()];
+        r.present = true;
+        r.removed = false;
+        r.position = pose.0;
+        r.heading = pose.1;
+        r.wheels = [0.0; 2];
+        self.arena.physics.teleport(r.handles.body, pose.0, pose.1);
+        self.arena.physics.set_enabled(r.handles, true);
+        self.set_alive(robot, true);
+        self.scene.rebuild(
+            &self.arena.robots,
+            &self.arena.obstacles,
+            &self.arena.targets,
+        );
+        Ok(pose)
     }
 
     /// Fills every robot's frame for the coming tick (`frames[i]` for robot i; extra frames are left alone).

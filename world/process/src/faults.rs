@@ -12,6 +12,9 @@
 //!    and the world waits for the launcher's `applied k` before it opens the tick; thawed robots then take part
 //!    again.
 //!
+//! 5. robots join and leave ([`arrivals`]): by the configuration's schedule, `swarm ctl spawn` and `swarm ctl
+//!    remove`.
+//!
 //! Every robot marked dead gets a resume point (its last recorded supervisor snapshot) before the launcher hears
 //! of it, so a replacement agent can continue from it. A dead robot stays in the arena as an inert body with its
 //! LEDs off; its frame says `alive = 0`, and anything its agent sends is ignored until it is back.
@@ -44,6 +47,10 @@ use swarm_world::recorder::Recorder;
 use crate::remote::{Link, Stop};
 use crate::report;
 
+mod arrivals;
+
+pub use arrivals::Arrivals;
+
 /// How often the world looks at joins and notices while it waits for agents before the first tick.
 const JOIN_POLL: Duration = Duration::from_millis(20);
 
@@ -67,6 +74,8 @@ enum Down {
 enum Robot {
     Alive,
     Down(Down),
+    /// Not in the run: before it joins, or after it left.
+    Absent,
 }
 
 /// The world's fault state: the plan, each robot's state and the launcher's lines.
@@ -94,6 +103,8 @@ pub struct FaultDriver {
     out_dir: PathBuf,
     join_timeout: Duration,
     apply_timeout: Duration,
+    /// Joins and leaves: the schedule's, and `swarm ctl`'s requests.
+    arrivals: Arrivals,
 }
 
 /// Reads the launcher's lines on standard input: a death notice reaches the transport at once (so the current
@@ -154,7 +165,13 @@ impl FaultDriver {
         due.clear();
         Ok(FaultDriver {
             plan,
-            robots: vec![Robot::Alive; robots],
+            robots: (0..robots)
+                .map(|r| match world.arena.robots.get(r) {
+                    Some(robot) if !robot.present => Robot::Absent,
+                    _ => Robot::Alive,
+                })
+                .collect(),
+            arrivals: Arrivals::default(),
             rejoin_at: vec![None; robots],
             startup_kills,
             commands,
@@ -175,6 +192,17 @@ impl FaultDriver {
     /// Whether robot `robot` takes part in the coming tick.
     pub fn is_alive(&self, robot: usize) -> bool {
         self.robots.get(robot) == Some(&Robot::Alive)
+    }
+
+    /// Carries out `arrivals` (the driver starts with none).
+    pub fn with_arrivals(mut self, arrivals: Arrivals) -> FaultDriver {
+        self.arrivals = arrivals;
+        self
+    }
+
+    /// Every join, refusal and leave of the run so far, for `summary.json`.
+    pub fn arrivals_summary(&self) -> serde_json::Value {
+        self.arrivals.summary()
     }
 
     /// Robots taking part.
@@ -266,7 +294,9 @@ impl FaultDriver {
                 Robot::Down(Down::Deadline | Down::Frozen) => {
                     self.robots[robot as usize] = Robot::Down(Down::Notice);
                 }
-                Robot::Down(Down::Notice | Down::Killed | Down::HostLost) => continue,
+                Robot::Down(Down::Notice | Down::Killed | Down::HostLost) | Robot::Absent => {
+                    continue;
+                }
             }
             report(WorldReport::Down {
                 tick,
@@ -320,6 +350,7 @@ impl FaultDriver {
                 }
             }
         }
+        self.arrivals(tick, link, world, recorder)?;
         self.scheduled(tick, link, world, recorder, commands)
     }
 
@@ -558,6 +589,8 @@ impl FaultDriver {
                 self.respawns.push(robot);
             }
             WorldCommand::KillHost(host) => self.host_kills.push(host),
+            WorldCommand::Spawn { robot, pose } => self.arrivals.request_spawn(robot, pose),
+            WorldCommand::Remove(robot) => self.arrivals.request_removal(robot),
             other => tracing::warn!(?other, "ignoring a launcher line that does not apply here"),
         }
     }

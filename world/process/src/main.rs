@@ -140,7 +140,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         launcher,
         args.out.clone(),
         &limits,
-    )?;
+    )?
+    .with_arrivals(faults::Arrivals::new(&world, &experiment));
     let mut recorder = Recorder::create(&args.out, &world, &[0])?;
     let mut post = PostOffice::new(&world, link.robots());
     recorder.record(&mut world)?;
@@ -226,6 +227,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     });
     if let Some(object) = extra.as_object_mut() {
         object.insert("alive_final".into(), faults.alive_count().into());
+        object.insert("arrivals".into(), faults.arrivals_summary());
         if let Some(hosts) = link.summary() {
             object.insert("hosts".into(), hosts);
         }

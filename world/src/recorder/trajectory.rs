@@ -1,6 +1,7 @@
 //! `trajectory.csv`: `tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive`, one row per robot per recorded
 //! tick, positions in metres and headings in radians in (-pi, pi]. As in `events.csv`, `robot` is the robot's index
-//! (the number `--fault`, `swarm ctl` and `summary.json` use) and `robot_id` its id from the configuration.
+//! (the number `--fault`, `swarm ctl` and `summary.json` use) and `robot_id` its id from the configuration. A robot
+//! that is not in the run at that tick (it joins later, or it left) has `NaN` for its pose and `alive` 0.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -37,9 +38,10 @@ impl PoseRow {
             .map(|(robot, r)| PoseRow {
                 tick: arena.tick,
                 robot: robot as u32,
-                x: r.position.x,
-                y: r.position.y,
-                heading: r.heading,
+                // A robot that is not in the run (yet, or any more) has no pose.
+                x: if r.present { r.position.x } else { f32::NAN },
+                y: if r.present { r.position.y } else { f32::NAN },
+                heading: if r.present { r.heading } else { f32::NAN },
                 led: r.led,
                 alive: r.alive,
             })

@@ -89,6 +89,7 @@ pub fn epuck(id: &str, line: u32) -> Entity {
         camera_aperture_deg: None,
         range_finder_range: None,
         shape: DiscShape::default(),
+        arrival: Default::default(),
         location: at(line),
     })
 }

@@ -4,8 +4,8 @@
 //! run directory (summary, trajectories, events, snapshot, logs). Ctrl-C stops the run cleanly: the world finishes
 //! its tick and flushes its records, and every process and shared-memory file of the run is removed.
 //! `swarm run --fault "kill robots=3 tick=50"` adds faults to the configuration's `<faults>`, and
-//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot> | kill-host <host>` drives a live
-//! run (docs/faults.md).
+//! `swarm ctl <run dir> list | kill <robot> | freeze <robot> | thaw <robot> | spawn <robot> [x y [heading]] |
+//! remove <robot> | kill-host <host>` drives a live run (docs/faults.md, docs/joins.md).
 //!
 //! `swarm host --connect <endpoint>` runs one machine's share of multi-host runs (docs/hosts.md); `swarm run
 //! --hosts a,b` places a run's robots on such hosts.
@@ -27,6 +27,7 @@ use swarm_cli::launcher::control::{self, CtlCommand};
 use swarm_cli::launcher::{self, RunOptions};
 use swarm_contract::config::hosts::TlsFiles;
 use swarm_contract::process::binaries::Binaries;
+use swarm_contract::protocol::launcher_to_world::SpawnPose;
 use swarm_remote::auth::{HostKey, Seal, create_missing_keys, default_key_dir, key_path};
 use swarm_remote::codec::DEFAULT_MAX_PAYLOAD;
 use swarm_remote::host::{self, HostOptions};
@@ -172,6 +173,26 @@ enum CtlRequestArg {
     KillHost {
         /// Host name.
         host: String,
+    },
+    /// Bring a robot that is not in the run (declared with `spare="true"`, or one that left) into the arena at
+    /// the next tick: where the configuration put it, or at X Y, at the nearest free place if that is taken.
+    Spawn {
+        /// Robot index.
+        robot: u32,
+        /// Position in metres (with Y).
+        #[arg(requires = "y", allow_negative_numbers = true)]
+        x: Option<f32>,
+        /// Position in metres.
+        #[arg(allow_negative_numbers = true)]
+        y: Option<f32>,
+        /// Heading in degrees, counter-clockwise from +X (default: the configured one).
+        #[arg(requires = "y", allow_negative_numbers = true)]
+        heading: Option<f32>,
+    },
+    /// Take a robot out of the run at the next tick: its agent stops (no restart) and its body leaves the arena.
+    Remove {
+        /// Robot index.
+        robot: u32,
     },
 }
 
@@ -411,6 +432,20 @@ fn ctl(run: &std::path::Path, request: CtlRequestArg) -> anyhow::Result<()> {
         CtlRequestArg::Freeze { robot } => CtlCommand::Freeze(robot),
         CtlRequestArg::Thaw { robot } => CtlCommand::Thaw(robot),
         CtlRequestArg::KillHost { host } => CtlCommand::KillHost(host),
+        CtlRequestArg::Spawn {
+            robot,
+            x,
+            y,
+            heading,
+        } => CtlCommand::Spawn {
+            robot,
+            pose: x.zip(y).map(|(x, y)| SpawnPose {
+                x,
+                y,
+                heading_deg: heading,
+            }),
+        },
+        CtlRequestArg::Remove { robot } => CtlCommand::Remove(robot),
     };
     let shown = command.to_string();
     let answer = control::request(run, command)

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use super::restart::{Ending, RestartTracker};
 use super::{LaunchError, io};
+use swarm_contract::config::Arrival;
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs, start_agent};
 use swarm_contract::run_dir;
 
@@ -22,6 +23,8 @@ pub enum AgentState {
     Restarting,
     /// Dead for good.
     Dead,
+    /// Not in the run: it joins later, or it left (docs/joins.md).
+    Absent,
 }
 
 impl AgentState {
@@ -32,6 +35,7 @@ impl AgentState {
             AgentState::Frozen => "frozen",
             AgentState::Restarting => "restarting",
             AgentState::Dead => "dead",
+            AgentState::Absent => "absent",
         }
     }
 }
@@ -60,12 +64,15 @@ pub struct RobotEntry {
 }
 
 impl RobotEntry {
-    /// A robot whose agent is not started yet.
-    pub fn new(controller: String, tracker: RestartTracker) -> RobotEntry {
+    /// A robot whose agent is not started yet; one that joins later is absent until then.
+    pub fn new(arrival: Arrival, controller: String, tracker: RestartTracker) -> RobotEntry {
         RobotEntry {
             controller,
             tracker,
-            state: AgentState::Running,
+            state: match arrival {
+                Arrival::Start => AgentState::Running,
+                Arrival::At(_) | Arrival::Spare => AgentState::Absent,
+            },
             pid: 0,
             first_pid: 0,
             ctl_killed: false,

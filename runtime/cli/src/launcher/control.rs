@@ -14,10 +14,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::time::Duration;
 
+use swarm_contract::protocol::launcher_to_world::SpawnPose;
 use swarm_contract::run_dir::CONTROL_SOCKET;
 
 /// A request to the launcher of a live run.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum CtlCommand {
     /// Every robot with its agent's process id and state.
     List,
@@ -29,6 +30,15 @@ pub enum CtlCommand {
     Thaw(u32),
     /// Make the named `swarm host` daemon of a multi-host run die.
     KillHost(String),
+    /// Bring an absent robot into the arena (where it was configured to join, or at a pose).
+    Spawn {
+        /// The robot.
+        robot: u32,
+        /// Where, if not where the configuration put it.
+        pose: Option<SpawnPose>,
+    },
+    /// Take a robot out of the run for good (its agent is stopped, its body leaves the arena).
+    Remove(u32),
 }
 
 impl fmt::Display for CtlCommand {
@@ -39,6 +49,17 @@ impl fmt::Display for CtlCommand {
             CtlCommand::Freeze(r) => write!(f, "freeze {r}"),
             CtlCommand::Thaw(r) => write!(f, "thaw {r}"),
             CtlCommand::KillHost(host) => write!(f, "kill-host {host}"),
+            CtlCommand::Spawn { robot, pose } => {
+                write!(f, "spawn {robot}")?;
+                if let Some(pose) = pose {
+                    write!(f, " {} {}", pose.x, pose.y)?;
+                    if let Some(heading) = pose.heading_deg {
+                        write!(f, " {heading}")?;
+                    }
+                }
+                Ok(())
+            }
+            CtlCommand::Remove(r) => write!(f, "remove {r}"),
         }
     }
 }
@@ -57,9 +78,40 @@ impl CtlCommand {
             ["freeze", r] => Ok(CtlCommand::Freeze(robot(r)?)),
             ["thaw", r] => Ok(CtlCommand::Thaw(robot(r)?)),
             ["kill-host", host] => Ok(CtlCommand::KillHost((*host).to_owned())),
+            ["remove", r] => Ok(CtlCommand::Remove(robot(r)?)),
+            ["spawn", r, rest @ ..] => {
+                let number = |w: &str| {
+                    w.parse::<f32>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| format!("'{w}' is not a number"))
+                };
+                let pose = match rest {
+                    [] => None,
+                    [x, y] => Some(SpawnPose {
+                        x: number(x)?,
+                        y: number(y)?,
+                        heading_deg: None,
+                    }),
+                    [x, y, heading] => Some(SpawnPose {
+                        x: number(x)?,
+                        y: number(y)?,
+                        heading_deg: Some(number(heading)?),
+                    }),
+                    _ => {
+                        return Err(
+                            "spawn takes a robot, then optionally x y [heading in degrees]".into(),
+                        );
+                    }
+                };
+                Ok(CtlCommand::Spawn {
+                    robot: robot(r)?,
+                    pose,
+                })
+            }
             _ => Err(format!(
-                "unknown request '{line}': use list, kill <robot>, freeze <robot>, thaw <robot> or \
-                 kill-host <host>"
+                "unknown request '{line}': use list, kill <robot>, freeze <robot>, thaw <robot>, \
+                 spawn <robot> [x y [heading]], remove <robot> or kill-host <host>"
             )),
         }
     }

@@ -31,6 +31,11 @@ impl Supervision {
     pub(super) fn start_agents(&mut self, startup: &[FaultAction]) -> Result<(), LaunchError> {
         self.children.agents.reserve(self.robots.len());
         for robot in 0..self.robots.len() as u32 {
+            // A robot that joins later gets its agent when it joins.
+            if self.robots[robot as usize].state == AgentState::Absent {
+                self.children.agents.push(None);
+                continue;
+            }
             let child = self
                 .spawner
                 .spawn(robot, &self.robots[robot as usize].controller, None)?;
@@ -215,6 +220,13 @@ impl Supervision {
             None => return,
         };
         for request in requests {
+            if matches!(
+                request.command,
+                CtlCommand::Spawn { .. } | CtlCommand::Remove(_)
+            ) {
+                self.request_arrival(request);
+                continue;
+            }
             let reply = self.control_request(request.command.clone());
             request.answer(reply);
         }
@@ -372,7 +384,7 @@ impl Supervision {
     }
 
     /// Whether the run's robots run on hosts.
-    fn on_hosts(&self) -> bool {
+    pub(super) fn on_hosts(&self) -> bool {
         !self.host_names.is_empty()
     }
 

@@ -16,6 +16,7 @@
 //! cuts the records back to the last complete tick ([`records`]), writes the summary and fails with the reason.
 
 mod agents;
+mod arrivals;
 pub mod as_run;
 pub mod control;
 mod fault_handling;
@@ -37,7 +38,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use nix::sys::signal::Signal;
 
 use agents::{AgentSpawner, RobotEntry};
-use control::ControlServer;
+use control::{ControlServer, CtlRequest};
 use fault_log::FaultRecord;
 use plain_progress::PlainProgress;
 use restart::RestartTracker;
@@ -392,6 +393,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .iter()
             .map(|r| {
                 RobotEntry::new(
+                    r.arrival,
                     r.controller.to_owned(),
                     RestartTracker::new(schedule.restart_rule(r.index, r.controller).cloned()),
                 )
@@ -411,6 +413,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             .map(|share| share.name.clone())
             .collect(),
         control,
+        pending_arrivals: Vec::new(),
     };
     if placement.is_none() {
         supervision.start_agents(&startup)?;
@@ -694,6 +697,8 @@ struct Supervision {
     /// The hosts of a multi-host run, in placement order (empty for a local run).
     host_names: Vec<String>,
     control: Option<ControlServer>,
+    /// `swarm ctl spawn` and `remove` requests waiting for the world's decision, by robot.
+    pending_arrivals: Vec<(u32, CtlRequest)>,
     /// How long agents get to exit by themselves after the run.
     agent_exit_grace: Duration,
     /// Progress as log lines when standard error is not a terminal (the bar is drawn only on one).
@@ -752,6 +757,13 @@ impl Supervision {
                 Ok(WorldReport::Await { tick }) => self.send_world(WorldCommand::Applied(tick)),
                 Ok(WorldReport::Down { tick, robot, cause }) => self.on_down(tick, robot, cause),
                 Ok(WorldReport::Up { tick, robot }) => self.on_up(tick, robot),
+                Ok(WorldReport::Joined { tick, robot }) => self.on_joined(tick, robot)?,
+                Ok(WorldReport::Refused {
+                    tick,
+                    robot,
+                    reason,
+                }) => self.on_refused(tick, robot, &reason),
+                Ok(WorldReport::Left { tick, robot }) => self.on_left(tick, robot),
                 Ok(WorldReport::Ready { .. }) | Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => {
                     // The world closed its output: it is exiting; its status says how.

@@ -149,6 +149,8 @@ pub struct Participant<'a> {
     pub controller: &'a str,
     /// The robot's element; `None` for a coordinator.
     pub robot: Option<&'a RobotEntity>,
+    /// When it enters the run: a coordinator at the start, a robot as its element says.
+    pub arrival: Arrival,
     /// Where its element is.
     pub location: Location,
 }
@@ -163,6 +165,7 @@ impl Experiment {
             id: r.id,
             controller: r.entity.controller.as_str(),
             robot: Some(r.entity),
+            arrival: r.entity.arrival,
             location: r.entity.location,
         });
         let coordinators = (first_coordinator..)
@@ -172,6 +175,7 @@ impl Experiment {
                 id: c.id.clone(),
                 controller: c.controller.as_str(),
                 robot: None,
+                arrival: Arrival::Start,
                 location: c.location,
             });
         robots.chain(coordinators).collect()
@@ -692,8 +696,22 @@ pub struct RobotEntity {
     pub range_finder_range: Option<f64>,
     /// The disc robot's body attributes (all `None` for the e-puck and the foot-bot, whose bodies are fixed).
     pub shape: DiscShape,
+    /// When the robot enters the arena (`join_tick`, `join_time`, `spare`; ours): at the start unless given.
+    pub arrival: Arrival,
     /// Where the element is.
     pub location: Location,
+}
+
+/// When a robot enters the arena (docs/joins.md).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Arrival {
+    /// At the start of the run.
+    #[default]
+    Start,
+    /// Mid-run, at a tick or time of the schedule (`join_tick`, `join_time`).
+    At(super::faults::At),
+    /// Only when `swarm ctl spawn` asks for it (`spare="true"`).
+    Spare,
 }
 
 impl RobotEntity {

@@ -5,8 +5,9 @@
 //! 58: the world holds that tick until it has joined) and `applied 50` (every fault due at tick 50 is done: the
 //! world may open the tick), `kill-host 1` (host 1 of the placement is to die: `swarm ctl kill-host`) and
 //! `respawn 3` (robot 3's restart policy replaces its agent: the world takes it back once the replacement is
-//! there; for a robot on a host the world has the host start it, resuming from the world's record). Plain text,
-//! so a person can drive a world by hand.
+//! there; for a robot on a host the world has the host start it, resuming from the world's record), `spawn 7
+//! [x y [heading]]` (`swarm ctl spawn`: absent robot 7 is to enter the arena) and `remove 7` (`swarm ctl
+//! remove`: robot 7 is to leave the run). Plain text, so a person can drive a world by hand.
 
 use std::fmt;
 use std::path::PathBuf;
@@ -79,8 +80,19 @@ impl WorldArgs {
     }
 }
 
+/// Where `swarm ctl spawn` asks a robot to enter the arena.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpawnPose {
+    /// Position in metres.
+    pub x: f32,
+    /// Position in metres.
+    pub y: f32,
+    /// Heading in degrees, counter-clockwise from +X (`None`: the heading it was given in the configuration).
+    pub heading_deg: Option<f32>,
+}
+
 /// One line from the launcher to the world.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum WorldCommand {
     /// Robot's agent is gone (death notice).
     Dead(u32),
@@ -97,6 +109,16 @@ pub enum WorldCommand {
     KillHost(u32),
     /// Robot gets a replacement agent.
     Respawn(u32),
+    /// `swarm ctl spawn`: the absent robot is to enter the arena at the next tick, where it was configured to
+    /// or at `pose`.
+    Spawn {
+        /// The robot.
+        robot: u32,
+        /// Where, if not where the configuration put it.
+        pose: Option<SpawnPose>,
+    },
+    /// `swarm ctl remove`: the robot is to leave the run at the next tick.
+    Remove(u32),
 }
 
 impl fmt::Display for WorldCommand {
@@ -107,6 +129,17 @@ impl fmt::Display for WorldCommand {
             WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
             WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
             WorldCommand::Respawn(robot) => write!(f, "respawn {robot}"),
+            WorldCommand::Spawn { robot, pose } => {
+                write!(f, "spawn {robot}")?;
+                if let Some(pose) = pose {
+                    write!(f, " {} {}", pose.x, pose.y)?;
+                    if let Some(heading) = pose.heading_deg {
+                        write!(f, " {heading}")?;
+                    }
+                }
+                Ok(())
+            }
+            WorldCommand::Remove(robot) => write!(f, "remove {robot}"),
         }
     }
 }
@@ -124,6 +157,31 @@ impl WorldCommand {
             ["applied", tick] => Some(WorldCommand::Applied(tick.parse().ok()?)),
             ["kill-host", host] => Some(WorldCommand::KillHost(host.parse().ok()?)),
             ["respawn", robot] => Some(WorldCommand::Respawn(robot.parse().ok()?)),
+            ["remove", robot] => Some(WorldCommand::Remove(robot.parse().ok()?)),
+            ["spawn", robot, rest @ ..] => {
+                let numbers: Vec<f32> = rest
+                    .iter()
+                    .map(|w| w.parse::<f32>().ok().filter(|v| v.is_finite()))
+                    .collect::<Option<_>>()?;
+                let pose = match numbers.as_slice() {
+                    [] => None,
+                    [x, y] => Some(SpawnPose {
+                        x: *x,
+                        y: *y,
+                        heading_deg: None,
+                    }),
+                    [x, y, heading] => Some(SpawnPose {
+                        x: *x,
+                        y: *y,
+                        heading_deg: Some(*heading),
+                    }),
+                    _ => return None,
+                };
+                Some(WorldCommand::Spawn {
+                    robot: robot.parse().ok()?,
+                    pose,
+                })
+            }
             _ => None,
         }
     }
@@ -167,6 +225,19 @@ mod tests {
             WorldCommand::Applied(50),
             WorldCommand::KillHost(1),
             WorldCommand::Respawn(4),
+            WorldCommand::Spawn {
+                robot: 7,
+                pose: None,
+            },
+            WorldCommand::Spawn {
+                robot: 7,
+                pose: Some(SpawnPose {
+                    x: 0.5,
+                    y: -1.25,
+                    heading_deg: Some(90.0),
+                }),
+            },
+            WorldCommand::Remove(7),
         ] {
             assert_eq!(WorldCommand::parse(&command.to_string()), Some(command));
         }

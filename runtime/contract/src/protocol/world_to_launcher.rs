@@ -4,15 +4,17 @@
 //! `ready 40`, `tick 120 answered 39 missing 0 dead 1`, `finished 600`, and for faults `fault 50 kill 3`
 //! (a scheduled fault is due; after the last one of a tick, `await 50`: the world waits for the launcher's
 //! `applied 50`), `down 51 3 notice` (the world
-//! marked robot 3 dead at tick 51; `deadline` when it missed one, `host` when its host was lost) and `up 80 3` (robot 3 takes part again from tick 80). Anything else on the
-//! world's standard output is ignored by the launcher.
+//! marked robot 3 dead at tick 51; `deadline` when it missed one, `host` when its host was lost) and `up 80 3` (robot 3 takes part again from tick 80).
+//! For joins and leaves (docs/joins.md): `joined 50 7` (robot 7 enters the arena at tick 50: the launcher starts
+//! its agent before it answers `await 50`), `refused 50 7 <reason>` (it could not) and `left 60 7` (it left the
+//! run: the launcher stops its agent). Anything else on the world's standard output is ignored by the launcher.
 
 use std::fmt;
 
 use crate::config::faults::FaultKind;
 
 /// One progress report of the world process.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum WorldReport {
     /// The services exist; agents may join. Carries the number of robots.
     Ready {
@@ -65,6 +67,29 @@ pub enum WorldReport {
         /// The robot.
         robot: u32,
     },
+    /// The robot entered the arena for tick `tick`; its agent is to start now.
+    Joined {
+        /// The first tick it takes part in.
+        tick: u64,
+        /// The robot.
+        robot: u32,
+    },
+    /// The robot could not enter the arena.
+    Refused {
+        /// The tick it was to join at.
+        tick: u64,
+        /// The robot.
+        robot: u32,
+        /// Why, for the user.
+        reason: String,
+    },
+    /// The robot left the run before tick `tick`; its agent is to stop now.
+    Left {
+        /// The first tick without it.
+        tick: u64,
+        /// The robot.
+        robot: u32,
+    },
 }
 
 /// How the world learnt that a robot is gone.
@@ -111,6 +136,13 @@ impl fmt::Display for WorldReport {
                 write!(f, "down {tick} {robot} {}", cause.name())
             }
             WorldReport::Up { tick, robot } => write!(f, "up {tick} {robot}"),
+            WorldReport::Joined { tick, robot } => write!(f, "joined {tick} {robot}"),
+            WorldReport::Refused {
+                tick,
+                robot,
+                reason,
+            } => write!(f, "refused {tick} {robot} {}", reason.replace('\n', " ")),
+            WorldReport::Left { tick, robot } => write!(f, "left {tick} {robot}"),
             WorldReport::Await { tick } => write!(f, "await {tick}"),
         }
     }
@@ -164,6 +196,19 @@ impl WorldReport {
                 tick: tick.parse().ok()?,
                 robot: robot.parse().ok()?,
             }),
+            ["joined", tick, robot] => Some(WorldReport::Joined {
+                tick: tick.parse().ok()?,
+                robot: robot.parse().ok()?,
+            }),
+            ["refused", tick, robot, reason @ ..] => Some(WorldReport::Refused {
+                tick: tick.parse().ok()?,
+                robot: robot.parse().ok()?,
+                reason: reason.join(" "),
+            }),
+            ["left", tick, robot] => Some(WorldReport::Left {
+                tick: tick.parse().ok()?,
+                robot: robot.parse().ok()?,
+            }),
             _ => None,
         }
     }
@@ -206,6 +251,13 @@ mod tests {
             },
             WorldReport::Up { tick: 80, robot: 3 },
             WorldReport::Await { tick: 50 },
+            WorldReport::Joined { tick: 50, robot: 7 },
+            WorldReport::Refused {
+                tick: 50,
+                robot: 7,
+                reason: "(0.500, 0.500) is taken by robot 'ep3'".into(),
+            },
+            WorldReport::Left { tick: 60, robot: 7 },
         ] {
             assert_eq!(WorldReport::parse(&report.to_string()), Some(report));
         }

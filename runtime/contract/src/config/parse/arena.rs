@@ -3,10 +3,11 @@
 
 use super::{Ctx, MediumRef};
 use crate::bodies::RobotKind;
+use crate::config::faults::At;
 use crate::config::model::{
-    Arena, BoxEntity, CylinderEntity, DiscShape, Distribute, Element, Entity, Euler, Floor,
-    FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity, Pose,
-    PositionMethod, RobotEntity, TargetEntity, Vec3,
+    Arena, Arrival, BoxEntity, CylinderEntity, DiscShape, Distribute, Element, Entity, Euler,
+    Floor, FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity,
+    Pose, PositionMethod, RobotEntity, TargetEntity, Vec3,
 };
 use crate::config::registry::MediumKind;
 use crate::config::suggest::did_you_mean;
@@ -419,7 +420,15 @@ fn positive_at_most(ctx: &mut Ctx, el: &Element, name: &str, max: f64) -> Option
 fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let kind = RobotKind::from_tag(&el.name)?;
     let body = kind.body();
-    let mut known = vec!["id", "rab_range", "rab_data_size", "range_finder_range"];
+    let mut known = vec![
+        "id",
+        "rab_range",
+        "rab_data_size",
+        "range_finder_range",
+        "join_tick",
+        "join_time",
+        "spare",
+    ];
     let mut shape = DiscShape::default();
     let mut shape_ok = true;
     if kind == RobotKind::Disc {
@@ -467,6 +476,7 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
     let aperture_ok = camera_aperture_deg
         .is_none_or(|a| ctx.in_range(el, "omnidirectional_camera_aperture", a, 0.0, Some(89.0)));
     let controller = controller_ref(ctx, el);
+    let arrival = arrival(ctx, el);
     (rab_range_ok && rab_data_size_ok && aperture_ok && shape_ok && range_finder_ok)
         .then_some(())?;
     Some(RobotEntity {
@@ -478,8 +488,45 @@ fn robot_entity(ctx: &mut Ctx, el: &Element) -> Option<RobotEntity> {
         camera_aperture_deg,
         range_finder_range: range_finder_range.flatten(),
         shape,
+        arrival: arrival?,
         location: el.location,
     })
+}
+
+/// `join_tick="T"` (T >= 1), `join_time="S"` (S > 0) or `spare="true"`: at most one; none is the start.
+fn arrival(ctx: &mut Ctx, el: &Element) -> Option<Arrival> {
+    let given: Vec<&str> = ["join_tick", "join_time", "spare"]
+        .into_iter()
+        .filter(|name| el.attributes.contains_key(*name))
+        .collect();
+    match given.as_slice() {
+        [] => Some(Arrival::Start),
+        ["join_tick"] => {
+            let tick: u64 = ctx.attr(el, "join_tick")?;
+            ctx.in_range(el, "join_tick", tick as f64, 1.0, None)
+                .then_some(Arrival::At(At::Tick(tick)))
+        }
+        ["join_time"] => {
+            let seconds = ctx.positive(el, "join_time")?;
+            Some(Arrival::At(At::Seconds(seconds)))
+        }
+        ["spare"] => match ctx.attr::<bool>(el, "spare")? {
+            true => Some(Arrival::Spare),
+            false => Some(Arrival::Start),
+        },
+        _ => {
+            ctx.error(
+                el.location,
+                format!(
+                    "<{}> gives {}; give at most one of join_tick, join_time and spare",
+                    el.name,
+                    given.join(" and ")
+                ),
+                None,
+            );
+            None
+        }
+    }
 }
 
 /// The one `<controller config="id"/>` child of a robot or coordinator element: the controller's id.
