@@ -384,7 +384,7 @@ mod tests {
              footbot_diffusion_controller, footbot_flocking_controller, footbot_foraging_controller, \
              footbot_gripping_controller, footbot_synchronization_controller, epuck_obstacleavoidance, \
              footbot_diffusion, footbot_flocking, footbot_foraging, footbot_gripping, footbot_synchronization, \
-             disc_wander, sensor_probe"
+             disc_wander, mail_probe, sensor_probe"
         );
     }
 }

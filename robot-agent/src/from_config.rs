@@ -176,7 +176,7 @@ mod tests {
         let e = experiment();
         assert_eq!(
             controller_of(&e, 2).unwrap_err().to_string(),
-            "/cfg/two.argos: there is no robot 2: the configuration has 2 robots"
+            "/cfg/two.argos: there is no robot 2: the configuration has 2 robots and coordinators"
         );
     }
 

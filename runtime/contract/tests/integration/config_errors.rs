@@ -990,7 +990,7 @@ fn unsupported_medium_lists_the_supported_ones() {
     assert_error(
         &text,
         "<simple_radio",
-        "medium <simple_radio> is not supported (supported media: led, range_and_bearing, pheromone)",
+        "medium <simple_radio> is not supported (supported media: led, range_and_bearing, pheromone, messages)",
     );
 }
 
@@ -1150,4 +1150,81 @@ fn an_arena_larger_than_the_physics_can_place_precisely_is_refused() {
             "{size}: {errors:?}"
         );
     }
+}
+
+#[test]
+fn messages_medium_limits_are_bounded() {
+    let text = config(&[("MEDIA", r#"<messages id="net" loss="1.5"/>"#)]);
+    assert_error(
+        &text,
+        "loss=",
+        "'loss' in <messages> must be between 0 and 1, got 1.5",
+    );
+    let text = config(&[("MEDIA", r#"<messages id="net" max_payload="300"/>"#)]);
+    assert_error(
+        &text,
+        "max_payload=",
+        "'max_payload' in <messages> must be between 1 and 256, got 300",
+    );
+    let text = config(&[("MEDIA", r#"<messages id="net" max_per_tick="0"/>"#)]);
+    assert_error(
+        &text,
+        "max_per_tick=",
+        "'max_per_tick' in <messages> must be between 1 and 32, got 0",
+    );
+}
+
+/// The base with `<coordinators>` holding `coordinators`, and `arena` in the arena.
+fn with_coordinators(arena: &str, coordinators: &str) -> String {
+    config(&[("ARENA", arena)]).replace(
+        "</argos-configuration>",
+        &format!("  <coordinators>{coordinators}</coordinators>\n</argos-configuration>"),
+    )
+}
+
+#[test]
+fn a_coordinator_names_a_declared_controller_and_an_id_of_its_own() {
+    let text = with_coordinators(
+        ARENA,
+        r#"<coordinator id="store"><controller config="fcd"/></coordinator>"#,
+    );
+    assert_eq!(
+        errors(&text),
+        [format!(
+            "{PATH}:{}: <coordinator> 'store' refers to controller 'fcd', which <controllers> does not declare \
+             (did you mean 'fdc'?)",
+            at(&text, "<coordinator id")
+        )]
+    );
+    let robot = r#"<e-puck id="ep"><body position="0,0,0"/><controller config="fdc"/></e-puck>"#;
+    let text = with_coordinators(
+        robot,
+        r#"<coordinator id="ep"><controller config="fdc"/></coordinator>"#,
+    );
+    assert_error(
+        &text,
+        "<coordinator id",
+        "duplicate id 'ep': a robot of the arena already uses it",
+    );
+}
+
+#[test]
+fn a_robot_joins_at_one_moment_from_the_first_tick_on() {
+    let robot = |attributes: &str| {
+        format!(
+            r#"<e-puck id="ep" {attributes}><body position="0,0,0"/><controller config="fdc"/></e-puck>"#
+        )
+    };
+    let text = config(&[("ARENA", &robot(r#"join_tick="0""#))]);
+    assert_error(
+        &text,
+        "join_tick=",
+        "'join_tick' in <e-puck> must be at least 1, got 0",
+    );
+    let text = config(&[("ARENA", &robot(r#"join_tick="5" spare="true""#))]);
+    assert_error(
+        &text,
+        "<e-puck",
+        "<e-puck> gives join_tick and spare; give at most one of join_tick, join_time and spare",
+    );
 }
