@@ -259,6 +259,73 @@ fn scheduled_joins_on_two_hosts_give_the_single_host_records() {
 }
 
 #[test]
+fn swarm_ctl_spawns_and_removes_robots_on_hosts() {
+    let hosts = Hosts::start(&["alpha", "beta"]);
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let mut run = BackgroundRun::start_config(
+        "configs/joins/late_arrivals.argos",
+        out.path(),
+        &hosts,
+        &["--ticks", "0", "--real-time"],
+    );
+    run.wait_for("first tick completed");
+    let joined = swarm_ctl(out.path(), &["spawn", "9"]);
+    let joined_at: u64 = joined
+        .trim_end()
+        .strip_prefix("robot 9 joins at tick ")
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{joined}"));
+    // The spare takes part: its agent on a host answers tick after tick (a robot that did not answer would be down
+    // from the next tick). The trajectory is written tick by tick.
+    let alive_since_join = || {
+        let text = std::fs::read_to_string(out.path().join("trajectory.csv")).unwrap_or_default();
+        let whole = text.rfind('\n').map_or("", |end| &text[..end]);
+        whole
+            .lines()
+            .filter(|l| l.split(',').nth(1) == Some("9"))
+            .filter(|l| l.split(',').next().and_then(|t| t.parse::<u64>().ok()) >= Some(joined_at))
+            .map(|l| l.ends_with(",1"))
+            .collect::<Vec<bool>>()
+    };
+    let deadline = std::time::Instant::now() + EVENT_TIMEOUT;
+    while alive_since_join().len() < 5 {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the run stopped recording"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(
+        alive_since_join().iter().all(|&alive| alive),
+        "{:?}",
+        alive_since_join()
+    );
+    let left = swarm_ctl(out.path(), &["remove", "1"]);
+    assert!(left.starts_with("robot 1 left at tick "), "{left}");
+    run.interrupt();
+    let summary = summary(out.path());
+    let by_ctl: Vec<(String, u64)> = summary["arrivals"]
+        .as_array()
+        .expect("arrivals")
+        .iter()
+        .filter(|a| a["by"] == "ctl")
+        .map(|a| {
+            (
+                a["what"].as_str().unwrap_or_default().to_owned(),
+                a["robot"].as_u64().unwrap_or(0),
+            )
+        })
+        .collect();
+    assert_eq!(by_ctl, [("join".to_owned(), 9), ("leave".to_owned(), 1)]);
+    let events = String::from_utf8(read(out.path(), "events.csv")).expect("UTF-8");
+    assert!(
+        events.contains(",9,spare0,join\n") && events.contains(",1,ep1,leave\n"),
+        "{events}"
+    );
+    hosts.stop_and_check_clean();
+}
+
+#[test]
 fn two_hosts_reproduce_the_single_host_trajectory_and_events() {
     let (_, _, hosts) = single_and_two_hosts(&[]);
     for (daemon, robot) in hosts.daemons.iter().zip([0, 5]) {
@@ -355,15 +422,17 @@ struct BackgroundRun {
 impl BackgroundRun {
     /// `swarm run` of the fault tests' experiment on `hosts`, with `extra` arguments.
     fn start(out: &Path, hosts: &Hosts, extra: &[&str]) -> BackgroundRun {
+        let robots = RUN_ROBOTS.to_string();
+        let mut args = vec!["--robots", &robots, "--ticks", "0", "--seed", "3"];
+        args.extend(extra);
+        BackgroundRun::start_config(OBSTACLE_AVOIDANCE, out, hosts, &args)
+    }
+
+    /// `swarm run config` on `hosts`, with `extra` arguments.
+    fn start_config(config: &str, out: &Path, hosts: &Hosts, extra: &[&str]) -> BackgroundRun {
         let dir = bin_dir();
         let mut child = Command::new(dir.join("swarm"))
-            .args([
-                "run",
-                OBSTACLE_AVOIDANCE,
-                "--robots",
-                &RUN_ROBOTS.to_string(),
-            ])
-            .args(["--ticks", "0", "--seed", "3"])
+            .args(["run", config])
             .args(["--tick-deadline-ms", "200", "--no-progress", "--out"])
             .arg(out)
             .args(hosts.run_args())
