@@ -559,3 +559,94 @@ pub fn wait_gone(pid: u32, limit: std::time::Duration) -> bool {
     unsafe { libc::close(fd) };
     ready > 0
 }
+
+/// Runs `swarm run <config> --out <out> --no-progress <extra>` (`config` relative to the workspace) to its end;
+/// the run must succeed and leave nothing behind.
+pub fn run_to_completion(config: &str, out: &Path, extra: &[&str]) {
+    let config = workspace_file(config).display().to_string();
+    let out = out.display().to_string();
+    let mut args = vec!["run", &config, "--out", &out, "--no-progress"];
+    args.extend_from_slice(extra);
+    let outcome = swarm(&args);
+    assert!(
+        outcome.output.status.success(),
+        "swarm run {config} failed:\n{}",
+        outcome.stderr()
+    );
+    assert_clean(&outcome);
+}
+
+/// A `swarm run` going on in the background, for `swarm ctl` tests: its launcher log is followed line by line.
+pub struct LiveSwarm {
+    child: std::process::Child,
+    log: std::io::BufReader<std::process::ChildStderr>,
+}
+
+impl LiveSwarm {
+    /// Starts `swarm <args>` and returns once its first tick completed.
+    pub fn start(args: &[&str]) -> LiveSwarm {
+        let mut child = spawn_swarm(args);
+        let log = std::io::BufReader::new(child.stderr.take().expect("stderr is piped"));
+        let mut live = LiveSwarm { child, log };
+        live.wait_for("first tick completed");
+        live
+    }
+
+    /// Reads the launcher's log up to the first line containing `needle` and returns that line.
+    pub fn wait_for(&mut self, needle: &str) -> String {
+        use std::io::BufRead;
+        let mut line = String::new();
+        loop {
+            line.clear();
+            let read = self.log.read_line(&mut line).expect("the launcher's log");
+            assert!(read > 0, "the launcher ended before logging `{needle}`");
+            if line.contains(needle) {
+                return line;
+            }
+        }
+    }
+
+    /// Interrupts the run (Ctrl-C), checks that it ended as an interrupted run (exit 130) and left nothing.
+    pub fn interrupt(mut self) {
+        use std::io::BufRead;
+        let pid = self.child.id();
+        nix::sys::signal::kill(
+            nix::unistd::Pid::from_raw(pid as i32),
+            nix::sys::signal::Signal::SIGINT,
+        )
+        .expect("interrupt the launcher");
+        let mut rest = String::new();
+        while self.log.read_line(&mut rest).unwrap_or(0) > 0 {}
+        let status = self.child.wait().expect("the launcher exits");
+        assert_eq!(status.code(), Some(130), "{rest}");
+        assert_nothing_left(pid);
+        remove_run_leftovers(&format!("sw{pid:x}-"));
+    }
+}
+
+impl Drop for LiveSwarm {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+            remove_run_leftovers(&format!("sw{:x}-", self.child.id()));
+        }
+    }
+}
+
+/// The `(what, robot)` of every entry of a run summary's `arrivals` made `by` (`schedule` or `ctl`), in order.
+pub fn arrivals_by(summary: &serde_json::Value, by: &str) -> Vec<(String, u64)> {
+    summary["arrivals"]
+        .as_array()
+        .map(Vec::as_slice)
+        .unwrap_or_default()
+        .iter()
+        .filter(|a| a["by"] == by)
+        .map(|a| {
+            (
+                a["what"].as_str().unwrap_or_default().to_owned(),
+                a["robot"].as_u64().unwrap_or(u64::MAX),
+            )
+        })
+        .collect()
+}

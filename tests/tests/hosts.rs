@@ -10,8 +10,8 @@ use std::time::Duration;
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
-    HostDaemon, Netns, TestKeys, assert_clean, bin_dir, follow_lines, free_port, shm_leftovers,
-    swarm, swarm_ctl, wait_for_line, workspace_root,
+    HostDaemon, Netns, TestKeys, arrivals_by, assert_clean, bin_dir, follow_lines, free_port,
+    shm_leftovers, swarm, swarm_ctl, wait_for_line, workspace_root,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -304,18 +304,7 @@ fn swarm_ctl_spawns_and_removes_robots_on_hosts() {
     assert!(left.starts_with("robot 1 left at tick "), "{left}");
     run.interrupt();
     let summary = summary(out.path());
-    let by_ctl: Vec<(String, u64)> = summary["arrivals"]
-        .as_array()
-        .expect("arrivals")
-        .iter()
-        .filter(|a| a["by"] == "ctl")
-        .map(|a| {
-            (
-                a["what"].as_str().unwrap_or_default().to_owned(),
-                a["robot"].as_u64().unwrap_or(0),
-            )
-        })
-        .collect();
+    let by_ctl = arrivals_by(&summary, "ctl");
     assert_eq!(by_ctl, [("join".to_owned(), 9), ("leave".to_owned(), 1)]);
     let events = String::from_utf8(read(out.path(), "events.csv")).expect("UTF-8");
     assert!(

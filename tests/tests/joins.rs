@@ -2,14 +2,10 @@
 //! configuration's schedule (`configs/joins/late_arrivals.argos`) and by `swarm ctl spawn` and `swarm ctl remove`.
 //! Across hosts: `hosts::scheduled_joins_on_two_hosts_give_the_single_host_records`.
 
-use std::io::{BufRead, BufReader};
 use std::path::Path;
 
-use nix::sys::signal::{Signal, kill};
-use nix::unistd::Pid;
 use swarm_system_tests::{
-    assert_clean, assert_nothing_left, remove_run_leftovers, spawn_swarm, swarm, swarm_ctl,
-    workspace_file,
+    LiveSwarm, arrivals_by, run_to_completion, swarm, swarm_ctl, workspace_file,
 };
 
 const LATE_ARRIVALS: &str = "configs/joins/late_arrivals.argos";
@@ -46,12 +42,8 @@ fn scheduled_joins_take_part_from_their_tick_and_a_blocked_one_is_refused_where_
     let runs: Vec<tempfile::TempDir> = (0..2)
         .map(|_| tempfile::tempdir().expect("a temporary directory"))
         .collect();
-    let config = workspace_file(LATE_ARRIVALS).display().to_string();
     for out in &runs {
-        let out_arg = out.path().display().to_string();
-        let outcome = swarm(&["run", &config, "--out", &out_arg, "--no-progress"]);
-        assert!(outcome.output.status.success(), "{}", outcome.stderr());
-        assert_clean(&outcome);
+        run_to_completion(LATE_ARRIVALS, out.path(), &[]);
     }
     let out = runs[0].path();
     let events = text(out, "events.csv");
@@ -106,7 +98,7 @@ fn swarm_ctl_spawns_spares_removes_robots_and_refuses_what_cannot_be() {
     let out = tempfile::tempdir().expect("a temporary directory");
     let out_arg = out.path().display().to_string();
     let config = workspace_file(LATE_ARRIVALS).display().to_string();
-    let mut child = spawn_swarm(&[
+    let run = LiveSwarm::start(&[
         "run",
         &config,
         "--no-progress",
@@ -116,14 +108,6 @@ fn swarm_ctl_spawns_spares_removes_robots_and_refuses_what_cannot_be() {
         "--out",
         &out_arg,
     ]);
-    let pid = child.id();
-    let mut log = BufReader::new(child.stderr.take().expect("stderr is piped"));
-    let mut line = String::new();
-    while log.read_line(&mut line).expect("the launcher's log") > 0
-        && !line.contains("first tick completed")
-    {
-        line.clear();
-    }
     let ctl = |request: &[&str]| swarm_ctl(out.path(), request);
     let joined = ctl(&["spawn", "9"]);
     assert!(joined.starts_with("robot 9 joins at tick "), "{joined}");
@@ -149,37 +133,20 @@ fn swarm_ctl_spawns_spares_removes_robots_and_refuses_what_cannot_be() {
         );
     }
     // Requests that cannot be carried out are refused with the reason; the run goes on.
-    let refused = swarm_system_tests::swarm(&["ctl", &out_arg, "spawn", "10"]);
+    let refused = swarm(&["ctl", &out_arg, "spawn", "10"]);
     assert!(
         refused.stderr().contains("robot 10 is in the run already"),
         "{}",
         refused.stderr()
     );
-    let refused = swarm_system_tests::swarm(&["ctl", &out_arg, "remove", "0"]);
+    let refused = swarm(&["ctl", &out_arg, "remove", "0"]);
     assert!(refused.stderr().contains("robot 0 is not in the run"));
-    let blocked = swarm_system_tests::swarm(&["ctl", &out_arg, "spawn", "8"]);
+    let blocked = swarm(&["ctl", &out_arg, "spawn", "8"]);
     assert!(blocked.stderr().contains("'block'"), "{}", blocked.stderr());
-    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
-    let mut rest = String::new();
-    while log.read_line(&mut rest).unwrap_or(0) > 0 {}
-    let status = child.wait().expect("the launcher exits");
-    assert_eq!(status.code(), Some(130), "{rest}");
-    assert_nothing_left(pid);
-    remove_run_leftovers(&format!("sw{pid:x}-"));
+    run.interrupt();
 
     let summary = summary(out.path());
-    let by_ctl: Vec<(String, u64)> = summary["arrivals"]
-        .as_array()
-        .expect("arrivals")
-        .iter()
-        .filter(|a| a["by"] == "ctl")
-        .map(|a| {
-            (
-                a["what"].as_str().unwrap_or_default().to_owned(),
-                a["robot"].as_u64().unwrap_or(u64::MAX),
-            )
-        })
-        .collect();
+    let by_ctl = arrivals_by(&summary, "ctl");
     for expected in [("join", 9), ("join", 10), ("leave", 0), ("join-refused", 8)] {
         assert!(
             by_ctl.contains(&(expected.0.to_owned(), expected.1)),

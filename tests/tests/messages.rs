@@ -6,15 +6,9 @@
 //! `hosts::messages_between_robots_on_two_hosts_have_the_fates_they_have_on_one`.
 
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader};
 use std::path::Path;
 
-use nix::sys::signal::{Signal, kill};
-use nix::unistd::Pid;
-use swarm_system_tests::{
-    assert_clean, assert_nothing_left, remove_run_leftovers, spawn_swarm, swarm, swarm_ctl,
-    workspace_file,
-};
+use swarm_system_tests::{LiveSwarm, run_to_completion, swarm_ctl, workspace_file};
 
 const TALK: &str = "configs/messages/talk.argos";
 const COORDINATOR: &str = "configs/messages/coordinator.argos";
@@ -32,21 +26,7 @@ struct Row {
 }
 
 fn run(out: &Path, extra: &[&str]) {
-    run_config(TALK, out, extra);
-}
-
-fn run_config(config: &str, out: &Path, extra: &[&str]) {
-    let config = workspace_file(config).display().to_string();
-    let out = out.display().to_string();
-    let mut args = vec!["run", &config, "--out", &out, "--no-progress"];
-    args.extend_from_slice(extra);
-    let outcome = swarm(&args);
-    assert!(
-        outcome.output.status.success(),
-        "swarm run {config} failed:\n{}",
-        outcome.stderr()
-    );
-    assert_clean(&outcome);
+    run_to_completion(TALK, out, extra);
 }
 
 /// The rows of `messages.csv` (of a live run: the lines written so far, up to the last whole one).
@@ -171,7 +151,7 @@ fn a_coordinator_answers_robots_and_the_run_goes_on_while_it_is_killed_and_resta
         .map(|_| tempfile::tempdir().expect("a temporary directory"))
         .collect();
     for out in &runs {
-        run_config(COORDINATOR, out.path(), &[]);
+        run_to_completion(COORDINATOR, out.path(), &[]);
     }
     let out = runs[0].path();
     let summary: serde_json::Value =
@@ -234,7 +214,7 @@ fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
     let out = tempfile::tempdir().expect("a temporary directory");
     let out_arg = out.path().display().to_string();
     let config = workspace_file(COORDINATOR).display().to_string();
-    let mut child = spawn_swarm(&[
+    let mut run = LiveSwarm::start(&[
         "run",
         &config,
         "--no-progress",
@@ -246,21 +226,8 @@ fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
         "--out",
         &out_arg,
     ]);
-    let pid = child.id();
-    let mut log = BufReader::new(child.stderr.take().expect("stderr is piped"));
-    let mut wait_for = |needle: &str| -> String {
-        let mut line = String::new();
-        loop {
-            line.clear();
-            let read = log.read_line(&mut line).expect("the launcher's log");
-            assert!(read > 0, "the launcher ended before `{needle}`");
-            if line.contains(needle) {
-                return line.clone();
-            }
-        }
-    };
     // The schedule's kill at tick 20 and the restart come first.
-    wait_for("robot 4 takes part again from tick 22");
+    run.wait_for("robot 4 takes part again from tick 22");
     let list = swarm_ctl(out.path(), &["list"]);
     assert!(
         list.lines()
@@ -270,7 +237,7 @@ fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
     assert_eq!(swarm_ctl(out.path(), &["freeze", "4"]), "robot 4 frozen\n");
     assert_eq!(swarm_ctl(out.path(), &["thaw", "4"]), "robot 4 thawed\n");
     assert_eq!(swarm_ctl(out.path(), &["kill", "4"]), "robot 4 killed\n");
-    let back = wait_for("robot 4 takes part again from tick");
+    let back = run.wait_for("robot 4 takes part again from tick");
     let back: u64 = back
         .trim_end()
         .rsplit(' ')
@@ -290,13 +257,7 @@ fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
         );
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
-    kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
-    let mut rest = String::new();
-    while log.read_line(&mut rest).unwrap_or(0) > 0 {}
-    let status = child.wait().expect("the launcher exits");
-    assert_eq!(status.code(), Some(130), "{rest}");
-    assert_nothing_left(pid);
-    remove_run_leftovers(&format!("sw{pid:x}-"));
+    run.interrupt();
     let summary: serde_json::Value =
         serde_json::from_str(&text(out.path(), "summary.json")).expect("summary.json");
     let faults: Vec<(String, u64, bool)> = summary["faults"]

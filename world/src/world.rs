@@ -463,13 +463,18 @@ impl World {
         if r.removed != removed {
             r.removed = removed;
             self.arena.physics.set_enabled(r.handles, !removed);
-            // The next frames must already see the arena without (or with) the body.
-            self.scene.rebuild(
-                &self.arena.robots,
-                &self.arena.obstacles,
-                &self.arena.targets,
-            );
         }
+        // The next frames must already see the arena without (or with) the body, and its LEDs off (or on).
+        self.index_bodies();
+    }
+
+    /// Rebuilds the scene's and the LED medium's indexes from the arena's bodies.
+    fn index_bodies(&mut self) {
+        self.scene.rebuild(
+            &self.arena.robots,
+            &self.arena.obstacles,
+            &self.arena.targets,
+        );
         self.leds
             .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
     }
@@ -495,13 +500,7 @@ impl World {
         r.present = false;
         r.removed = true;
         self.arena.physics.set_enabled(r.handles, false);
-        self.scene.rebuild(
-            &self.arena.robots,
-            &self.arena.obstacles,
-            &self.arena.targets,
-        );
-        self.leds
-            .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+        self.index_bodies();
     }
 
     /// Brings the absent `robot` into the arena at `wanted` (position and heading; default: the pose the
@@ -530,11 +529,6 @@ impl World {
         self.arena.physics.teleport(r.handles.body, pose.0, pose.1);
         self.arena.physics.set_enabled(r.handles, true);
         self.set_alive(robot, true);
-        self.scene.rebuild(
-            &self.arena.robots,
-            &self.arena.obstacles,
-            &self.arena.targets,
-        );
         Ok(pose)
     }
 
@@ -720,13 +714,7 @@ impl World {
     }
 
     fn update_media(&mut self) {
-        self.scene.rebuild(
-            &self.arena.robots,
-            &self.arena.obstacles,
-            &self.arena.targets,
-        );
-        self.leds
-            .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
+        self.index_bodies();
         self.rab.commit(&self.arena.robots);
         self.arena.pheromone.step();
     }

@@ -6,7 +6,51 @@
 //! into the `BufWriter` as byte slices. Floats are written in `ryu`'s shortest round-trip form (`1.0`, `0.25`,
 //! `1.5E-7`), which every CSV reader parses.
 
+use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::error::WorldError;
+
+/// One record file: created with its header line, written through [`CsvLine`]s, errors naming its path.
+pub struct CsvFile {
+    path: PathBuf,
+    out: BufWriter<File>,
+}
+
+impl CsvFile {
+    /// Creates (truncates) `path` with a buffer of `capacity` bytes and writes `header` as its first line.
+    pub fn create(path: &Path, header: &str, capacity: usize) -> Result<CsvFile, WorldError> {
+        let file = File::create(path).map_err(|source| WorldError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut csv = CsvFile {
+            path: path.to_path_buf(),
+            out: BufWriter::with_capacity(capacity, file),
+        };
+        writeln!(csv.out, "{header}").map_err(|source| csv.error(source))?;
+        Ok(csv)
+    }
+
+    /// Starts a line.
+    pub fn line(&mut self) -> CsvLine<'_, File> {
+        CsvLine::new(&mut self.out)
+    }
+
+    /// Writes the buffer to the file.
+    pub fn flush(&mut self) -> Result<(), WorldError> {
+        self.out.flush().map_err(|source| self.error(source))
+    }
+
+    /// `source` as an error of this file.
+    pub fn error(&self, source: std::io::Error) -> WorldError {
+        WorldError::Io {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
 
 /// Writes one line's fields, separated by commas, into `out`; [`CsvLine::end`] ends the line.
 pub struct CsvLine<'a, W: Write> {

@@ -5,13 +5,11 @@
 //! `fault:<what>` in the event column (docs/faults.md).
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use swarm_contract::run_dir::{EVENT_TABLES_FILE, EVENTS_FILE};
 
-use super::csv_line::CsvLine;
+use super::csv_line::CsvFile;
 use crate::arena::Arena;
 use crate::error::WorldError;
 use crate::world::Coordinator;
@@ -41,8 +39,7 @@ pub enum EventRow {
 
 /// Writes `events.csv`.
 pub struct EventsWriter {
-    path: PathBuf,
-    out: BufWriter<File>,
+    file: CsvFile,
     /// Per participant (robots, then coordinators): its id and its controller's event names by event id.
     robots: Vec<(String, Vec<String>)>,
 }
@@ -64,13 +61,7 @@ impl EventsWriter {
             })?,
             Err(_) => BTreeMap::new(),
         };
-        let path = dir.join(EVENTS_FILE);
-        let io_error = |source| WorldError::Io {
-            path: path.clone(),
-            source,
-        };
-        let mut out = BufWriter::new(File::create(&path).map_err(io_error)?);
-        writeln!(out, "tick,robot,robot_id,event").map_err(io_error)?;
+        let file = CsvFile::create(&dir.join(EVENTS_FILE), "tick,robot,robot_id,event", 1 << 13)?;
         let named = |id: &str, controller: &str| {
             (
                 id.to_owned(),
@@ -83,24 +74,17 @@ impl EventsWriter {
             .map(|r| named(&r.name, &r.controller))
             .chain(coordinators.iter().map(|c| named(&c.id, &c.controller)))
             .collect();
-        Ok(EventsWriter { path, out, robots })
+        Ok(EventsWriter { file, robots })
     }
 
     /// Formats `row` into the file's buffer.
     pub fn write_row(&mut self, row: &EventRow) -> Result<(), WorldError> {
-        self.format(row).map_err(|source| self.error(source))
+        self.format(row).map_err(|source| self.file.error(source))
     }
 
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
-        self.out.flush().map_err(|source| self.error(source))
-    }
-
-    fn error(&self, source: std::io::Error) -> WorldError {
-        WorldError::Io {
-            path: self.path.clone(),
-            source,
-        }
+        self.file.flush()
     }
 
     fn format(&mut self, row: &EventRow) -> std::io::Result<()> {
@@ -110,20 +94,23 @@ impl EventsWriter {
             }
         };
         let robot_entry = self.robots.get(robot as usize);
-        let start = |out| CsvLine::new(out).int(tick)?.int(robot);
+        if let (EventRow::Fired { .. }, None) = (row, robot_entry) {
+            // Not a robot of this run: nothing to name it by.
+            return Ok(());
+        }
+        let line = self.file.line().int(tick)?.int(robot)?;
         match (*row, robot_entry) {
             (EventRow::Fault { name, .. }, _) => {
                 let id = robot_entry.map_or("", |(id, _)| id.as_str());
-                start(&mut self.out)?.text(id)?.text(name)?.end()
+                line.text(id)?.text(name)?.end()
             }
             (EventRow::Fired { event, .. }, Some((id, names))) => {
-                let line = start(&mut self.out)?.text(id)?;
+                let line = line.text(id)?;
                 match names.get(usize::from(event)) {
                     Some(name) => line.text(name)?.end(),
                     None => line.prefixed_int("#", event)?.end(),
                 }
             }
-            // Not a robot of this run: nothing to name it by.
             (EventRow::Fired { .. }, None) => Ok(()),
         }
     }

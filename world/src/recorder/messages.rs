@@ -1,55 +1,43 @@
 //! `messages.csv`: every decision of the messages medium (`crate::media::mail`), one row per message and
 //! recipient, or one row for a message refused as a whole (docs/records.md).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use swarm_contract::mail::Address;
 use swarm_contract::run_dir::MESSAGES_FILE;
 
-use super::csv_line::CsvLine;
+use super::csv_line::CsvFile;
 use crate::error::WorldError;
 use crate::media::mail::MessageRecord;
 
 /// Writes `messages.csv`.
 pub struct MessagesWriter {
-    path: PathBuf,
-    out: BufWriter<File>,
+    file: CsvFile,
 }
 
 impl MessagesWriter {
     /// Creates `messages.csv` in `dir` with its header line.
     pub fn create(dir: &Path) -> Result<MessagesWriter, WorldError> {
-        let path = dir.join(MESSAGES_FILE);
-        let io_error = |source| WorldError::Io {
-            path: path.clone(),
-            source,
-        };
-        let mut out = BufWriter::new(File::create(&path).map_err(io_error)?);
-        writeln!(out, "tick,from,to,address,bytes,outcome,reason").map_err(io_error)?;
-        Ok(MessagesWriter { path, out })
+        let file = CsvFile::create(
+            &dir.join(MESSAGES_FILE),
+            "tick,from,to,address,bytes,outcome,reason",
+            1 << 13,
+        )?;
+        Ok(MessagesWriter { file })
     }
 
     /// Formats `row` into the file's buffer.
     pub fn write_row(&mut self, row: &MessageRecord) -> Result<(), WorldError> {
-        self.format(row).map_err(|source| self.error(source))
+        self.format(row).map_err(|source| self.file.error(source))
     }
 
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
-        self.out.flush().map_err(|source| self.error(source))
-    }
-
-    fn error(&self, source: std::io::Error) -> WorldError {
-        WorldError::Io {
-            path: self.path.clone(),
-            source,
-        }
+        self.file.flush()
     }
 
     fn format(&mut self, row: &MessageRecord) -> std::io::Result<()> {
-        let line = CsvLine::new(&mut self.out).int(row.tick)?.int(row.from)?;
+        let line = self.file.line().int(row.tick)?.int(row.from)?;
         let line = match row.to {
             Some(to) => line.int(to)?,
             None => line.text("")?,

@@ -3,13 +3,11 @@
 //! (the number `--fault`, `swarm ctl` and `summary.json` use) and `robot_id` its id from the configuration. A robot
 //! that is not in the run at that tick (it joins later, or it left) has `NaN` for its pose and `alive` 0.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use swarm_contract::messages::Rgb;
 
-use super::csv_line::CsvLine;
+use super::csv_line::CsvFile;
 use crate::arena::Arena;
 use crate::error::WorldError;
 
@@ -58,8 +56,7 @@ fn wrapped(angle: f32) -> f32 {
 
 /// A buffered trajectory file.
 pub struct TrajectoryWriter {
-    path: PathBuf,
-    out: BufWriter<File>,
+    file: CsvFile,
     /// The configuration's robot ids, by robot index.
     names: Vec<String>,
 }
@@ -67,34 +64,20 @@ pub struct TrajectoryWriter {
 impl TrajectoryWriter {
     /// Creates (truncates) the file for the arena's robots and writes the header.
     pub fn create(path: &Path, arena: &Arena) -> Result<Self, WorldError> {
-        let file = File::create(path).map_err(|source| WorldError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let mut writer = Self {
-            path: path.to_path_buf(),
-            out: BufWriter::with_capacity(1 << 16, file),
+        Ok(Self {
+            file: CsvFile::create(path, TRAJECTORY_HEADER, 1 << 16)?,
             names: arena.robots.iter().map(|r| r.name.clone()).collect(),
-        };
-        writeln!(writer.out, "{TRAJECTORY_HEADER}").map_err(|source| writer.error(source))?;
-        Ok(writer)
-    }
-
-    fn error(&self, source: std::io::Error) -> WorldError {
-        WorldError::Io {
-            path: self.path.clone(),
-            source,
-        }
+        })
     }
 
     /// Formats `row` into the file's buffer.
     pub fn write_row(&mut self, row: &PoseRow) -> Result<(), WorldError> {
-        self.format(row).map_err(|source| self.error(source))
+        self.format(row).map_err(|source| self.file.error(source))
     }
 
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
-        self.out.flush().map_err(|source| self.error(source))
+        self.file.flush()
     }
 
     fn format(&mut self, row: &PoseRow) -> std::io::Result<()> {
@@ -102,7 +85,8 @@ impl TrajectoryWriter {
             .names
             .get(row.robot as usize)
             .map_or("", String::as_str);
-        CsvLine::new(&mut self.out)
+        self.file
+            .line()
             .int(row.tick)?
             .int(row.robot)?
             .text(name)?

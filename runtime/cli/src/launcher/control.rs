@@ -49,16 +49,11 @@ impl fmt::Display for CtlCommand {
             CtlCommand::Freeze(r) => write!(f, "freeze {r}"),
             CtlCommand::Thaw(r) => write!(f, "thaw {r}"),
             CtlCommand::KillHost(host) => write!(f, "kill-host {host}"),
-            CtlCommand::Spawn { robot, pose } => {
-                write!(f, "spawn {robot}")?;
-                if let Some(pose) = pose {
-                    write!(f, " {} {}", pose.x, pose.y)?;
-                    if let Some(heading) = pose.heading_deg {
-                        write!(f, " {heading}")?;
-                    }
-                }
-                Ok(())
-            }
+            CtlCommand::Spawn { robot, pose: None } => write!(f, "spawn {robot}"),
+            CtlCommand::Spawn {
+                robot,
+                pose: Some(pose),
+            } => write!(f, "spawn {robot} {pose}"),
             CtlCommand::Remove(r) => write!(f, "remove {r}"),
         }
     }
@@ -79,36 +74,10 @@ impl CtlCommand {
             ["thaw", r] => Ok(CtlCommand::Thaw(robot(r)?)),
             ["kill-host", host] => Ok(CtlCommand::KillHost((*host).to_owned())),
             ["remove", r] => Ok(CtlCommand::Remove(robot(r)?)),
-            ["spawn", r, rest @ ..] => {
-                let number = |w: &str| {
-                    w.parse::<f32>()
-                        .ok()
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| format!("'{w}' is not a number"))
-                };
-                let pose = match rest {
-                    [] => None,
-                    [x, y] => Some(SpawnPose {
-                        x: number(x)?,
-                        y: number(y)?,
-                        heading_deg: None,
-                    }),
-                    [x, y, heading] => Some(SpawnPose {
-                        x: number(x)?,
-                        y: number(y)?,
-                        heading_deg: Some(number(heading)?),
-                    }),
-                    _ => {
-                        return Err(
-                            "spawn takes a robot, then optionally x y [heading in degrees]".into(),
-                        );
-                    }
-                };
-                Ok(CtlCommand::Spawn {
-                    robot: robot(r)?,
-                    pose,
-                })
-            }
+            ["spawn", r, rest @ ..] => Ok(CtlCommand::Spawn {
+                robot: robot(r)?,
+                pose: SpawnPose::parse_words(rest)?,
+            }),
             _ => Err(format!(
                 "unknown request '{line}': use list, kill <robot>, freeze <robot>, thaw <robot>, \
                  spawn <robot> [x y [heading]], remove <robot> or kill-host <host>"
@@ -293,6 +262,42 @@ mod tests {
         assert!(
             !dir.path().join(CONTROL_SOCKET).exists(),
             "the socket is removed"
+        );
+    }
+
+    #[test]
+    fn every_request_parses_back_from_its_line() {
+        for command in [
+            CtlCommand::List,
+            CtlCommand::Kill(3),
+            CtlCommand::Freeze(3),
+            CtlCommand::Thaw(3),
+            CtlCommand::KillHost("beta".into()),
+            CtlCommand::Spawn {
+                robot: 9,
+                pose: None,
+            },
+            CtlCommand::Spawn {
+                robot: 9,
+                pose: Some(SpawnPose {
+                    x: -0.25,
+                    y: 1.5,
+                    heading_deg: Some(45.0),
+                }),
+            },
+            CtlCommand::Remove(2),
+        ] {
+            assert_eq!(CtlCommand::parse(&command.to_string()), Ok(command));
+        }
+        assert!(
+            CtlCommand::parse("spawn 9 1.0")
+                .unwrap_err()
+                .contains("optionally x y")
+        );
+        assert!(
+            CtlCommand::parse("spawn 9 1.0 nan")
+                .unwrap_err()
+                .contains("'nan' is not a number")
         );
     }
 

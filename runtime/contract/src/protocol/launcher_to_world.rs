@@ -91,6 +91,43 @@ pub struct SpawnPose {
     pub heading_deg: Option<f32>,
 }
 
+impl SpawnPose {
+    /// Reads the words after a spawn request's robot: none, `x y`, or `x y heading`.
+    pub fn parse_words(words: &[&str]) -> Result<Option<SpawnPose>, String> {
+        let number = |w: &str| {
+            w.parse::<f32>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("'{w}' is not a number"))
+        };
+        match words {
+            [] => Ok(None),
+            [x, y] => Ok(Some(SpawnPose {
+                x: number(x)?,
+                y: number(y)?,
+                heading_deg: None,
+            })),
+            [x, y, heading] => Ok(Some(SpawnPose {
+                x: number(x)?,
+                y: number(y)?,
+                heading_deg: Some(number(heading)?),
+            })),
+            _ => Err("a spawn takes a robot, then optionally x y [heading in degrees]".into()),
+        }
+    }
+}
+
+/// The words `parse_words` reads: `x y` or `x y heading`.
+impl fmt::Display for SpawnPose {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {}", self.x, self.y)?;
+        match self.heading_deg {
+            Some(heading) => write!(f, " {heading}"),
+            None => Ok(()),
+        }
+    }
+}
+
 /// One line from the launcher to the world.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum WorldCommand {
@@ -129,16 +166,11 @@ impl fmt::Display for WorldCommand {
             WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
             WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
             WorldCommand::Respawn(robot) => write!(f, "respawn {robot}"),
-            WorldCommand::Spawn { robot, pose } => {
-                write!(f, "spawn {robot}")?;
-                if let Some(pose) = pose {
-                    write!(f, " {} {}", pose.x, pose.y)?;
-                    if let Some(heading) = pose.heading_deg {
-                        write!(f, " {heading}")?;
-                    }
-                }
-                Ok(())
-            }
+            WorldCommand::Spawn { robot, pose: None } => write!(f, "spawn {robot}"),
+            WorldCommand::Spawn {
+                robot,
+                pose: Some(pose),
+            } => write!(f, "spawn {robot} {pose}"),
             WorldCommand::Remove(robot) => write!(f, "remove {robot}"),
         }
     }
@@ -158,30 +190,10 @@ impl WorldCommand {
             ["kill-host", host] => Some(WorldCommand::KillHost(host.parse().ok()?)),
             ["respawn", robot] => Some(WorldCommand::Respawn(robot.parse().ok()?)),
             ["remove", robot] => Some(WorldCommand::Remove(robot.parse().ok()?)),
-            ["spawn", robot, rest @ ..] => {
-                let numbers: Vec<f32> = rest
-                    .iter()
-                    .map(|w| w.parse::<f32>().ok().filter(|v| v.is_finite()))
-                    .collect::<Option<_>>()?;
-                let pose = match numbers.as_slice() {
-                    [] => None,
-                    [x, y] => Some(SpawnPose {
-                        x: *x,
-                        y: *y,
-                        heading_deg: None,
-                    }),
-                    [x, y, heading] => Some(SpawnPose {
-                        x: *x,
-                        y: *y,
-                        heading_deg: Some(*heading),
-                    }),
-                    _ => return None,
-                };
-                Some(WorldCommand::Spawn {
-                    robot: robot.parse().ok()?,
-                    pose,
-                })
-            }
+            ["spawn", robot, rest @ ..] => Some(WorldCommand::Spawn {
+                robot: robot.parse().ok()?,
+                pose: SpawnPose::parse_words(rest).ok()?,
+            }),
             _ => None,
         }
     }

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::node::Node;
 use iceoryx2::port::reader::{EntryHandle, Reader, ReaderCreateError};
 use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
-use iceoryx2::prelude::ipc;
+use iceoryx2::prelude::{ZeroCopySend, ipc};
 
 use super::TransportError;
 use super::run::RunSpec;
@@ -140,6 +140,14 @@ struct MailPorts {
     _inbox_board: Board,
 }
 
+/// A board with one entry per robot, the agent's reader of it and its robot's entry (the caller keeps them so that the
+/// entry drops first and the board last).
+type OwnEntry<T> = (
+    Board,
+    Reader<ipc::Service, u32>,
+    EntryHandle<ipc::Service, u32, T>,
+);
+
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
@@ -240,19 +248,12 @@ impl AgentLink {
                     waited_ms: waited.elapsed().as_millis(),
                 })?;
         let node = services::node(run, &format!("robot-{robot}"))?;
-        let frame_board = services::open_frame_board(&node, robot, sync.capacity())?;
-        let frame_reader = frame_board.reader_builder().create().map_err(|e| match e {
-            ReaderCreateError::ExceedsMaxSupportedReaders => TransportError::ServiceFull {
-                robot,
-                service: services::frame_service_name(),
-                limit: sync.capacity() as usize + services::SPARE_AGENT_PLACES,
-                what: "readers",
-            },
-            other => TransportError::iceoryx("reading the frame board", other),
-        })?;
-        let frame_entry = frame_reader
-            .entry::<SensorFrame>(&robot)
-            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s frame entry"), e))?;
+        let (frame_board, frame_reader, frame_entry) = Self::read_own_entry::<SensorFrame>(
+            &node,
+            &services::frame_service_name(),
+            robot,
+            sync.capacity(),
+        )?;
         let command_board = services::open_command_board(&node, robot, generation)?;
         let command_writer = command_board
             .writer_builder()
@@ -297,25 +298,41 @@ impl AgentLink {
         capacity: u32,
         outbox: EntryHandleMut<ipc::Service, u32, Mailbox>,
     ) -> Result<MailPorts, TransportError> {
-        let board = services::open_inbox_board(node, robot, capacity)?;
-        let reader = board.reader_builder().create().map_err(|e| match e {
-            ReaderCreateError::ExceedsMaxSupportedReaders => TransportError::ServiceFull {
-                robot,
-                service: services::inbox_service_name(),
-                limit: capacity as usize + services::SPARE_AGENT_PLACES,
-                what: "readers",
-            },
-            other => TransportError::iceoryx("reading the inbox board", other),
-        })?;
-        let inbox = reader
-            .entry::<Mailbox>(&robot)
-            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s inbox entry"), e))?;
+        let (board, reader, inbox) = Self::read_own_entry::<Mailbox>(
+            node,
+            &services::inbox_service_name(),
+            robot,
+            capacity,
+        )?;
         Ok(MailPorts {
             inbox,
             outbox,
             _inbox_reader: reader,
             _inbox_board: board,
         })
+    }
+
+    /// Opens the board `name` that has one entry per robot (of `capacity`) and this robot's entry in it.
+    fn read_own_entry<T: Copy + ZeroCopySend>(
+        node: &Node<ipc::Service>,
+        name: &str,
+        robot: u32,
+        capacity: u32,
+    ) -> Result<OwnEntry<T>, TransportError> {
+        let board = services::open_per_robot_board(node, name, robot, capacity)?;
+        let reader = board.reader_builder().create().map_err(|e| match e {
+            ReaderCreateError::ExceedsMaxSupportedReaders => TransportError::ServiceFull {
+                robot,
+                service: name.to_owned(),
+                limit: capacity as usize + services::SPARE_AGENT_PLACES,
+                what: "readers",
+            },
+            other => TransportError::iceoryx(format!("reading {name}"), other),
+        })?;
+        let entry = reader
+            .entry::<T>(&robot)
+            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s entry of {name}"), e))?;
+        Ok((board, reader, entry))
     }
 
     /// The robot this agent runs.

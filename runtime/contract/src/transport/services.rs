@@ -8,7 +8,9 @@
 //! after a death the world creates the next generation of that robot's command board for the replacement. docs/transport.md says why blackboards and not publish-subscribe.
 
 use iceoryx2::node::Node;
-use iceoryx2::prelude::{NodeBuilder, NodeName, ServiceName, SignalHandlingMode, ipc};
+use iceoryx2::prelude::{
+    NodeBuilder, NodeName, ServiceName, SignalHandlingMode, ZeroCopySend, ipc,
+};
 use iceoryx2::service::builder::blackboard::BlackboardOpenError;
 use iceoryx2::service::port_factory::blackboard::PortFactory;
 
@@ -70,18 +72,7 @@ pub(crate) fn create_frame_board(
     node: &Node<ipc::Service>,
     robots: u32,
 ) -> Result<Board, TransportError> {
-    let name = frame_service_name();
-    let mut creator = node
-        .service_builder(&service_name(&name)?)
-        .blackboard_creator::<u32>()
-        .max_readers(robots as usize + SPARE_AGENT_PLACES)
-        .max_nodes(robots as usize + 1 + SPARE_AGENT_PLACES);
-    for robot in 0..robots {
-        creator = creator.add::<SensorFrame>(robot, SensorFrame::empty(robot));
-    }
-    creator
-        .create()
-        .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
+    create_per_robot_board(node, &frame_service_name(), robots, SensorFrame::empty)
 }
 
 /// World side: creates the inbox board with one mailbox per robot, readable by `robots` agents (plus spares).
@@ -89,38 +80,40 @@ pub(crate) fn create_inbox_board(
     node: &Node<ipc::Service>,
     robots: u32,
 ) -> Result<Board, TransportError> {
-    let name = inbox_service_name();
+    create_per_robot_board(node, &inbox_service_name(), robots, Mailbox::empty)
+}
+
+/// Creates the board `name` with the entry `initial(robot)` for every robot, readable by `robots` agents (plus
+/// spares), written by the world.
+fn create_per_robot_board<T: ZeroCopySend + Copy + 'static>(
+    node: &Node<ipc::Service>,
+    name: &str,
+    robots: u32,
+    initial: fn(u32) -> T,
+) -> Result<Board, TransportError> {
     let mut creator = node
-        .service_builder(&service_name(&name)?)
+        .service_builder(&service_name(name)?)
         .blackboard_creator::<u32>()
         .max_readers(robots as usize + SPARE_AGENT_PLACES)
         .max_nodes(robots as usize + 1 + SPARE_AGENT_PLACES);
     for robot in 0..robots {
-        creator = creator.add::<Mailbox>(robot, Mailbox::empty(robot));
+        creator = creator.add::<T>(robot, initial(robot));
     }
     creator
         .create()
         .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
 }
 
-/// Agent side: opens the inbox board of a run of `robots` robots as robot `robot`'s agent.
-pub(crate) fn open_inbox_board(
+/// Agent side: opens the board `name` that has one entry per robot (the frame board, the inbox board) of a run of
+/// `robots` robots, as robot `robot`'s agent.
+pub(crate) fn open_per_robot_board(
     node: &Node<ipc::Service>,
+    name: &str,
     robot: u32,
     robots: u32,
 ) -> Result<Board, TransportError> {
     let nodes = robots as usize + 1 + SPARE_AGENT_PLACES;
-    open_board(node, robot, &inbox_service_name(), nodes)
-}
-
-/// Agent side: opens the frame board of a run of `robots` robots as robot `robot`'s agent.
-pub(crate) fn open_frame_board(
-    node: &Node<ipc::Service>,
-    robot: u32,
-    robots: u32,
-) -> Result<Board, TransportError> {
-    let nodes = robots as usize + 1 + SPARE_AGENT_PLACES;
-    open_board(node, robot, &frame_service_name(), nodes)
+    open_board(node, robot, name, nodes)
 }
 
 /// World side: creates generation `generation` of robot `robot`'s command board (one writer, the robot's

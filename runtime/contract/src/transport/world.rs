@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::node::Node;
 use iceoryx2::port::reader::{EntryHandle, Reader};
 use iceoryx2::port::writer::{EntryHandleMut, Writer};
-use iceoryx2::prelude::ipc;
+use iceoryx2::prelude::{ZeroCopySend, ipc};
 
 use super::TransportError;
 use super::cleaner::Cleaner;
@@ -280,17 +280,8 @@ impl WorldLink {
         mail: bool,
     ) -> Result<Boards, TransportError> {
         let frame_board = services::create_frame_board(node, robots)?;
-        let frame_writer = frame_board
-            .writer_builder()
-            .create()
-            .map_err(|e| TransportError::iceoryx("writing the frame board", e))?;
-        let frame_entries = (0..robots)
-            .map(|robot| {
-                frame_writer
-                    .entry::<SensorFrame>(&robot)
-                    .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s frame entry"), e))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let (frame_writer, frame_entries) =
+            every_entry::<SensorFrame>(&frame_board, robots, "frame")?;
         let commands = (0..robots)
             .map(|robot| CommandBoard::create(node, robot, 0, mail))
             .collect::<Result<Vec<_>, _>>()?;
@@ -311,17 +302,7 @@ impl WorldLink {
         robots: u32,
     ) -> Result<InboxBoard, TransportError> {
         let board = services::create_inbox_board(node, robots)?;
-        let writer = board
-            .writer_builder()
-            .create()
-            .map_err(|e| TransportError::iceoryx("writing the inbox board", e))?;
-        let entries = (0..robots)
-            .map(|robot| {
-                writer
-                    .entry::<Mailbox>(&robot)
-                    .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s inbox entry"), e))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let (writer, entries) = every_entry::<Mailbox>(&board, robots, "inbox")?;
         Ok(InboxBoard {
             entries,
             _writer: writer,
@@ -572,6 +553,33 @@ impl WorldLink {
     pub fn statuses(&self) -> &[CommandStatus] {
         &self.status
     }
+}
+
+/// The world's writer of a board with one entry per robot (the frame board, the inbox board), and every robot's
+/// entry handle, in robot order.
+type Entries<T> = (
+    Writer<ipc::Service, u32>,
+    Vec<EntryHandleMut<ipc::Service, u32, T>>,
+);
+
+/// Opens the world's writer of `board` (one entry per robot of `robots`) and every robot's entry.
+fn every_entry<T: Copy + ZeroCopySend>(
+    board: &Board,
+    robots: u32,
+    what: &str,
+) -> Result<Entries<T>, TransportError> {
+    let writer = board
+        .writer_builder()
+        .create()
+        .map_err(|e| TransportError::iceoryx(format!("writing the {what} board"), e))?;
+    let entries = (0..robots)
+        .map(|robot| {
+            writer
+                .entry::<T>(&robot)
+                .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s {what} entry"), e))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((writer, entries))
 }
 
 impl Drop for WorldLink {
