@@ -560,12 +560,11 @@ pub fn wait_gone(pid: u32, limit: std::time::Duration) -> bool {
     ready > 0
 }
 
-/// Runs `swarm run <config> --out <out> --no-progress <extra>` (`config` relative to the workspace) to its end;
-/// the run must succeed and leave nothing behind.
-pub fn run_to_completion(config: &str, out: &Path, extra: &[&str]) {
-    let config = workspace_file(config).display().to_string();
+/// Runs `swarm run <config> --out <out> --no-progress <extra>` from the workspace (`config` relative to it, or
+/// absolute) to its end; the run must succeed and leave nothing behind.
+pub fn run_to_completion(config: &str, out: &Path, extra: &[&str]) -> SwarmOutcome {
     let out = out.display().to_string();
-    let mut args = vec!["run", &config, "--out", &out, "--no-progress"];
+    let mut args = vec!["run", config, "--out", &out, "--no-progress"];
     args.extend_from_slice(extra);
     let outcome = swarm(&args);
     assert!(
@@ -574,6 +573,21 @@ pub fn run_to_completion(config: &str, out: &Path, extra: &[&str]) {
         outcome.stderr()
     );
     assert_clean(&outcome);
+    outcome
+}
+
+/// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.
+pub fn assert_same_records(a: &Path, b: &Path, files: &[&str]) {
+    for file in files {
+        let read =
+            |dir: &Path| std::fs::read(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(
+            read(a) == read(b),
+            "{file} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
 }
 
 /// A `swarm run` going on in the background, for `swarm ctl` tests: its launcher log is followed line by line.
@@ -583,6 +597,25 @@ pub struct LiveSwarm {
 }
 
 impl LiveSwarm {
+    /// Starts `swarm run <config> --out <out>` (`config` relative to the workspace) paced in real time and
+    /// practically endless, with `extra` arguments; returns once its first tick completed.
+    pub fn run(config: &str, out: &Path, extra: &[&str]) -> LiveSwarm {
+        let config = workspace_file(config).display().to_string();
+        let out = out.display().to_string();
+        let mut args = vec![
+            "run",
+            &config,
+            "--no-progress",
+            "--real-time",
+            "--ticks",
+            "1000000",
+            "--out",
+            &out,
+        ];
+        args.extend_from_slice(extra);
+        LiveSwarm::start(&args)
+    }
+
     /// Starts `swarm <args>` and returns once its first tick completed.
     pub fn start(args: &[&str]) -> LiveSwarm {
         let mut child = spawn_swarm(args);

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    LiveSwarm, arrivals_by, run_to_completion, swarm, swarm_ctl, workspace_file,
+    LiveSwarm, arrivals_by, assert_same_records, run_to_completion, swarm, swarm_ctl,
 };
 
 const LATE_ARRIVALS: &str = "configs/joins/late_arrivals.argos";
@@ -84,30 +84,18 @@ fn scheduled_joins_take_part_from_their_tick_and_a_blocked_one_is_refused_where_
     // Each joined robot's agent was started when it joined: it has a log, the refused one has none.
     assert!(out.join("logs/robot-4.log").is_file());
     assert!(!out.join("logs/robot-8.log").exists());
-    for file in ["trajectory.csv", "events.csv"] {
-        assert_eq!(
-            text(runs[0].path(), file),
-            text(runs[1].path(), file),
-            "{file} of two runs with the same seed"
-        );
-    }
+    assert_same_records(
+        runs[0].path(),
+        runs[1].path(),
+        &["trajectory.csv", "events.csv"],
+    );
 }
 
 #[test]
 fn swarm_ctl_spawns_spares_removes_robots_and_refuses_what_cannot_be() {
     let out = tempfile::tempdir().expect("a temporary directory");
     let out_arg = out.path().display().to_string();
-    let config = workspace_file(LATE_ARRIVALS).display().to_string();
-    let run = LiveSwarm::start(&[
-        "run",
-        &config,
-        "--no-progress",
-        "--real-time",
-        "--ticks",
-        "100000",
-        "--out",
-        &out_arg,
-    ]);
+    let run = LiveSwarm::run(LATE_ARRIVALS, out.path(), &[]);
     let ctl = |request: &[&str]| swarm_ctl(out.path(), request);
     let joined = ctl(&["spawn", "9"]);
     assert!(joined.starts_with("robot 9 joins at tick "), "{joined}");

@@ -8,7 +8,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use swarm_system_tests::{LiveSwarm, run_to_completion, swarm_ctl, workspace_file};
+use swarm_system_tests::{LiveSwarm, assert_same_records, run_to_completion, swarm_ctl};
 
 const TALK: &str = "configs/messages/talk.argos";
 const COORDINATOR: &str = "configs/messages/coordinator.argos";
@@ -200,32 +200,17 @@ fn a_coordinator_answers_robots_and_the_run_goes_on_while_it_is_killed_and_resta
         let answering = tick >= 2 && !(20..=22).contains(&tick);
         assert_eq!(answers, if answering { 4 } else { 0 }, "tick {tick}");
     }
-    for (file, what) in [("messages.csv", "messages"), ("events.csv", "events")] {
-        assert_eq!(
-            text(runs[0].path(), file),
-            text(runs[1].path(), file),
-            "the {what} of two runs with the same seed"
-        );
-    }
+    assert_same_records(
+        runs[0].path(),
+        runs[1].path(),
+        &["messages.csv", "events.csv"],
+    );
 }
 
 #[test]
 fn swarm_ctl_freezes_thaws_and_kills_a_coordinator_like_a_robot() {
     let out = tempfile::tempdir().expect("a temporary directory");
-    let out_arg = out.path().display().to_string();
-    let config = workspace_file(COORDINATOR).display().to_string();
-    let mut run = LiveSwarm::start(&[
-        "run",
-        &config,
-        "--no-progress",
-        "--real-time",
-        "--ticks",
-        "100000",
-        "--tick-deadline-ms",
-        "100",
-        "--out",
-        &out_arg,
-    ]);
+    let mut run = LiveSwarm::run(COORDINATOR, out.path(), &["--tick-deadline-ms", "100"]);
     // The schedule's kill at tick 20 and the restart come first.
     run.wait_for("robot 4 takes part again from tick 22");
     let list = swarm_ctl(out.path(), &["list"]);

@@ -8,8 +8,8 @@ use std::process::{Command, Stdio};
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use swarm_system_tests::{
-    SwarmOutcome, assert_clean, bin_dir, iceoryx_root_leftovers, process_leftovers, shm_leftovers,
-    swarm, wait_gone, workspace_file, workspace_root,
+    SwarmOutcome, assert_clean, bin_dir, iceoryx_root_leftovers, process_leftovers,
+    run_to_completion, shm_leftovers, swarm, wait_gone, workspace_file, workspace_root,
 };
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
@@ -24,17 +24,7 @@ fn summary(out: &Path) -> serde_json::Value {
 }
 
 fn run_ok(config: &str, out: &Path, extra: &[&str]) -> SwarmOutcome {
-    let out_arg = out.display().to_string();
-    let mut args = vec!["run", config, "--out", out_arg.as_str(), "--no-progress"];
-    args.extend_from_slice(extra);
-    let outcome = swarm(&args);
-    assert!(
-        outcome.output.status.success(),
-        "swarm run {config} failed:\n{}",
-        outcome.stderr()
-    );
-    assert_clean(&outcome);
-    outcome
+    run_to_completion(config, out, extra)
 }
 
 #[test]
