@@ -7,6 +7,7 @@
 
 use std::fmt;
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::player::EventCallbacks;
 use swarm_contract::supervisor_gen::compiled::CompiledEvent;
@@ -115,6 +116,26 @@ pub fn bind<P: Profile>(state: P, events: &[CompiledEvent]) -> Result<Bound<P>, 
     }
 }
 
+/// The messages of a bound profile: its [`Profile::receive`] and [`Profile::send`], whatever its memory type.
+pub trait Talk {
+    /// Takes in the tick's messages before the supervisors step.
+    fn receive(&mut self, inbox: &Mailbox);
+    /// Sends what the step left to send.
+    fn send(&mut self, outbox: &mut Mailbox);
+}
+
+impl<P: Profile> Talk for Bound<P> {
+    #[unsafe(link_section = "swarm_hot")]
+    fn receive(&mut self, inbox: &Mailbox) {
+        self.state.receive(inbox);
+    }
+
+    #[unsafe(link_section = "swarm_hot")]
+    fn send(&mut self, outbox: &mut Mailbox) {
+        self.state.send(outbox);
+    }
+}
+
 impl<P: Profile> EventCallbacks for Bound<P> {
     #[unsafe(link_section = "swarm_hot")]
     fn check(&mut self, event: u8, frame: &SensorFrame) -> bool {
@@ -146,6 +167,7 @@ impl<P: Profile> EventCallbacks for Bound<P> {
 mod tests {
     use super::*;
     use crate::params::{ParamError, Params};
+    use swarm_contract::mail::Address;
 
     /// A two-event profile that counts actions, enough to test binding rules.
     struct Counter {
@@ -171,6 +193,14 @@ mod tests {
         fn from_params(_: &Params) -> Result<Self, ParamError> {
             Ok(Counter { acted: 0 })
         }
+
+        fn receive(&mut self, inbox: &Mailbox) {
+            self.acted += inbox.messages().len() as u32;
+        }
+
+        fn send(&mut self, outbox: &mut Mailbox) {
+            let _ = outbox.send(Address::All, &self.acted.to_le_bytes());
+        }
     }
 
     fn ev(name: &str, controllable: bool) -> CompiledEvent {
@@ -191,6 +221,20 @@ mod tests {
         bound.act(0, &frame, &mut command);
         assert_eq!(bound.state().acted, 1);
         assert_eq!(command.wheels, [1.0, 1.0]);
+    }
+
+    #[test]
+    fn a_bound_profile_receives_and_sends_through_its_memory() {
+        let events = [ev("count", true), ev("seen", false)];
+        let mut bound = bind(Counter { acted: 0 }, &events).unwrap();
+        let mut inbox = Mailbox::empty(0);
+        inbox.send(Address::To(0), b"one").unwrap();
+        inbox.send(Address::To(0), b"two").unwrap();
+        bound.receive(&inbox);
+        bound.act(0, &SensorFrame::empty(0), &mut ActuatorCommand::idle(0, 1));
+        let mut outbox = Mailbox::empty(0);
+        bound.send(&mut outbox);
+        assert_eq!(outbox.messages()[0].payload(), 3u32.to_le_bytes());
     }
 
     #[test]

@@ -11,6 +11,7 @@ use swarm_contract::supervisor_gen::compiled::SupervisorSet;
 use thiserror::Error;
 use tracing::info;
 
+use crate::binding::Talk;
 use crate::controller::{Plan, Supervisors};
 use crate::native::{self, BoxedNative, NativeError};
 use crate::params::Params;
@@ -68,9 +69,9 @@ impl Control {
         }
     }
 
-    /// One control step: the player's step with the bound callbacks, or the native controller's step with the
-    /// tick's `inbox` and an `outbox` for what it sends (supervised controllers do not talk yet). `command`
-    /// carries the actuator state over from the previous tick; allocates nothing.
+    /// One control step with the tick's `inbox` and an `outbox` for what the robot sends: the profile takes in
+    /// its messages, the player steps with the bound callbacks, the profile sends; or the native controller's
+    /// step. `command` carries the actuator state over from the previous tick; allocates nothing.
     #[unsafe(link_section = "swarm_hot")]
     pub fn step(
         &mut self,
@@ -80,7 +81,11 @@ impl Control {
         command: &mut ActuatorCommand,
     ) {
         match self {
-            Control::Supervised { player, callbacks } => player.step(frame, callbacks, command),
+            Control::Supervised { player, callbacks } => {
+                callbacks.receive(inbox);
+                player.step(frame, callbacks, command);
+                callbacks.send(outbox);
+            }
             Control::Native(native) => {
                 command.events_len = 0;
                 native.step_with_mail(frame, inbox, outbox, command);

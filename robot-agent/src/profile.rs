@@ -3,8 +3,12 @@
 //! A profile is a type holding one robot's memory and parameters; its [`Profile::PROCEDURES`] table maps the event
 //! names the models use to plain function pointers. Controllable events get an action on the
 //! [`ActuatorCommand`]; uncontrollable events get a pure check of the [`SensorFrame`] (docs/ptsct.md 8.2). A profile
-//! never sees the world or the supervisors: only the frame of the current tick and its own memory.
+//! never sees the world or the supervisors: only the frame of the current tick and its own memory. A profile that
+//! talks (docs/messages.md) reads the tick's messages into its memory before the supervisors step
+//! ([`Profile::receive`]), so that checks can see them, and sends what its actions left to send after the step
+//! ([`Profile::send`]).
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 
 use crate::params::{ParamError, Params};
@@ -41,4 +45,16 @@ pub trait Profile: Sized + Send + 'static {
 
     /// A fresh robot memory with parameters read from `params`.
     fn from_params(params: &Params) -> Result<Self, ParamError>;
+
+    /// Takes in the messages delivered this tick, before the supervisors step: a message an uncontrollable event
+    /// waits for becomes memory its check reads. By default messages are ignored. Must not allocate.
+    fn receive(&mut self, inbox: &Mailbox) {
+        let _ = inbox;
+    }
+
+    /// Puts into `outbox` (empty at the start of every tick) what this tick's actions left in memory to send,
+    /// after the supervisors stepped. By default nothing is sent. Must not allocate.
+    fn send(&mut self, outbox: &mut Mailbox) {
+        let _ = outbox;
+    }
 }

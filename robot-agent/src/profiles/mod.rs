@@ -10,12 +10,13 @@ pub mod phototaxis;
 pub mod synchronisation;
 pub mod timer;
 
+use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::player::EventCallbacks;
 use swarm_contract::supervisor_gen::compiled::CompiledEvent;
 use thiserror::Error;
 
-use crate::binding::{BindError, bind};
+use crate::binding::{BindError, Talk, bind};
 use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
@@ -26,8 +27,23 @@ use pheromone_foraging::PheromoneForager;
 use phototaxis::Phototaxis;
 use synchronisation::{Synchronisation, SynchronisationSct};
 
+/// What a bound profile is to the agent: the player's callbacks and the profile's messages.
+trait ProfileCallbacks: EventCallbacks + Talk + Send {}
+
+impl<T: EventCallbacks + Talk + Send> ProfileCallbacks for T {}
+
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
-pub struct BoxedCallbacks(Box<dyn EventCallbacks + Send>);
+pub struct BoxedCallbacks(Box<dyn ProfileCallbacks>);
+
+impl Talk for BoxedCallbacks {
+    fn receive(&mut self, inbox: &Mailbox) {
+        self.0.receive(inbox);
+    }
+
+    fn send(&mut self, outbox: &mut Mailbox) {
+        self.0.send(outbox);
+    }
+}
 
 impl EventCallbacks for BoxedCallbacks {
     fn check(&mut self, event: u8, frame: &SensorFrame) -> bool {
