@@ -19,7 +19,6 @@ use robot_agent::params::Params;
 use robot_agent::resume::Resumer;
 use swarm_contract::config::Experiment;
 use swarm_contract::limits::Limits;
-use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::protocol::launcher_to_agent::AgentArgs;
 use swarm_contract::protocol::resume::ResumePoint;
@@ -193,20 +192,19 @@ fn tick_loop(
 ) -> Result<()> {
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
     let mut command = ActuatorCommand::idle(robot, 0);
-    let mut outbox = Mailbox::empty(robot);
+    link.set_sender(robot);
     while let Some(mut tick) = link.next_tick().context("waiting for a tick")? {
         if STOP_REQUESTED.load(Ordering::Relaxed) {
             info!(robot, "asked to stop: leaving the run");
             return Ok(());
         }
-        outbox.clear();
-        let (frame, inbox) = tick.frame_and_inbox();
+        let (frame, inbox, outbox) = tick.parts();
         if resumer.before_step(control, frame)? {
-            control.step(frame, inbox, &mut outbox, &mut command);
+            control.step(frame, inbox, outbox, &mut command);
         } else {
             command.events_len = 0;
         }
-        tick.answer_with_mail(&mut command, &outbox);
+        tick.answer(&mut command);
     }
     info!(robot, "the world ended the run");
     Ok(())

@@ -25,6 +25,8 @@ pub const MAIL_PAYLOAD_BYTES: usize = 256;
 pub const MAILBOX_CAPACITY: usize = 32;
 /// The `to` of a message for every participant (alone: all; with a range: those within it).
 pub const TO_ALL: u32 = u32::MAX;
+/// The `len` of a closed mailbox ([`Mailbox::closed`]).
+const CLOSED: u32 = u32::MAX;
 
 /// Whom a message is for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,6 +49,9 @@ pub enum SendError {
     /// The payload is longer than [`MAIL_PAYLOAD_BYTES`].
     #[error("a payload of {0} bytes is longer than the {MAIL_PAYLOAD_BYTES} a message holds")]
     TooLong(usize),
+    /// The run has no `<messages>` medium: nothing can be sent.
+    #[error("the run has no <messages> medium: nothing can be sent")]
+    NoMedium,
 }
 
 /// One message.
@@ -136,9 +141,19 @@ impl Mailbox {
         }
     }
 
+    /// The outbox of a robot in a run without a `<messages>` medium: it holds nothing and refuses every message
+    /// ([`SendError::NoMedium`]).
+    pub fn closed(owner: u32) -> Mailbox {
+        Mailbox {
+            len: CLOSED,
+            ..Mailbox::empty(owner)
+        }
+    }
+
     /// The valid messages.
     pub fn messages(&self) -> &[Mail] {
-        &self.mail[..(self.len as usize).min(MAILBOX_CAPACITY)]
+        let len = if self.len == CLOSED { 0 } else { self.len };
+        &self.mail[..(len as usize).min(MAILBOX_CAPACITY)]
     }
 
     /// Whether it holds no message.
@@ -146,13 +161,18 @@ impl Mailbox {
         self.messages().is_empty()
     }
 
-    /// Empties it (the messages' bytes stay until overwritten; only `len` counts).
+    /// Empties it (the messages' bytes stay until overwritten; only `len` counts); a closed one stays closed.
     pub fn clear(&mut self) {
-        self.len = 0;
+        if self.len != CLOSED {
+            self.len = 0;
+        }
     }
 
     /// Appends `mail`.
     pub fn push(&mut self, mail: Mail) -> Result<(), SendError> {
+        if self.len == CLOSED {
+            return Err(SendError::NoMedium);
+        }
         let at = self.len as usize;
         if at >= MAILBOX_CAPACITY {
             return Err(SendError::OutboxFull);
@@ -256,6 +276,15 @@ mod tests {
         );
         assert_eq!(outbox.messages().len(), MAILBOX_CAPACITY);
         assert!(outbox.messages().iter().all(|m| m.from == 3));
+    }
+
+    #[test]
+    fn a_closed_outbox_refuses_everything_and_stays_closed() {
+        let mut outbox = Mailbox::closed(2);
+        assert_eq!(outbox.send(Address::All, b"x"), Err(SendError::NoMedium));
+        outbox.clear();
+        assert_eq!(outbox.send(Address::All, b"x"), Err(SendError::NoMedium));
+        assert!(outbox.is_empty());
     }
 
     #[test]

@@ -48,60 +48,44 @@ impl Tick<'_> {
         self.link.frame.tick
     }
 
-    /// The robot's frame and the messages delivered to it this tick (none in a run without mail). The inbox is
-    /// loaded from the inbox board only when the frame says messages wait.
+    /// The robot's frame, the messages delivered to it this tick and an empty outbox for what it sends in its
+    /// answer. In a run without mail the inbox is always empty and the outbox refuses every message
+    /// ([`SendError::NoMedium`](crate::mail::SendError)); neither is touched per tick, so a robot that does not
+    /// talk pays nothing for them. The inbox is loaded from the inbox board only when the frame says messages
+    /// wait.
     #[unsafe(link_section = "swarm_hot")]
-    pub fn frame_and_inbox(&mut self) -> (&SensorFrame, &Mailbox) {
+    pub fn parts(&mut self) -> (&SensorFrame, &Mailbox, &mut Mailbox) {
         let link = &mut *self.link;
-        let tick = link.frame.tick;
-        if link.inbox.tick != tick {
-            link.inbox.clear();
-            link.inbox.tick = tick;
-            if let Some(entry) = link
-                .ports
-                .mail
-                .as_ref()
-                .filter(|_| link.frame.inbox_len > 0)
-            {
-                let posted = *entry.inbox.get();
+        let mail = &mut *link.mail;
+        if let Some(ports) = &mail.ports {
+            let tick = link.frame.tick;
+            mail.inbox.clear();
+            if link.frame.inbox_len > 0 {
+                let posted = *ports.inbox.get();
                 if posted.tick == tick {
-                    link.inbox = posted;
+                    mail.inbox = posted;
                 }
             }
+            mail.outbox.clear();
         }
-        (&link.frame, &link.inbox)
+        (&link.frame, &mail.inbox, &mut mail.outbox)
     }
 
-    /// Sends `command` as the robot's answer to this tick, with its `tick` and `robot` fields set here, and
+    /// Sends `command` as the robot's answer to this tick, with its `tick` and `robot` fields set here, and the
+    /// messages of its outbox ([`Tick::parts`]; the world decides their fate and delivers them in the next tick);
     /// counts the robot as answered (the last answer of the tick wakes the world).
     #[unsafe(link_section = "swarm_hot")]
     pub fn answer(self, command: &mut ActuatorCommand) {
         command.outbox_len = 0;
-        self.send_answer(command);
-    }
-
-    /// Like [`Tick::answer`], with the messages of `outbox` (the world decides their fate and delivers them in
-    /// the next tick). In a run without mail the messages go nowhere and the agent says so once.
-    #[unsafe(link_section = "swarm_hot")]
-    pub fn answer_with_mail(self, command: &mut ActuatorCommand, outbox: &Mailbox) {
-        command.outbox_len = 0;
-        if !outbox.is_empty() {
-            match self.link.ports.mail.as_ref() {
-                Some(mail) => {
-                    let mut posted = *outbox;
-                    posted.tick = self.link.frame.tick;
-                    posted.owner = self.link.robot;
-                    mail.outbox.update_with_copy(posted);
-                    command.outbox_len = outbox.messages().len() as u8;
-                }
-                None if !self.link.warned_no_mail => {
-                    self.link.warned_no_mail = true;
-                    tracing::warn!(
-                        robot = self.link.robot,
-                        "the controller sends messages, but the run has no <messages> medium: they go nowhere"
-                    );
-                }
-                None => {}
+        let link = &mut *self.link;
+        if let Some(ports) = &link.mail.ports {
+            let outbox = &link.mail.outbox;
+            if !outbox.is_empty() {
+                let mut posted = *outbox;
+                posted.tick = link.frame.tick;
+                posted.owner = link.robot;
+                ports.outbox.update_with_copy(posted);
+                command.outbox_len = outbox.messages().len() as u8;
             }
         }
         self.send_answer(command);
@@ -123,12 +107,20 @@ impl Tick<'_> {
 struct Ports {
     frame_entry: EntryHandle<ipc::Service, u32, SensorFrame>,
     command_entry: EntryHandleMut<ipc::Service, u32, ActuatorCommand>,
-    mail: Option<MailPorts>,
     _frame_reader: Reader<ipc::Service, u32>,
     _command_writer: Writer<ipc::Service, u32>,
     _command_board: Board,
     _frame_board: Board,
     _node: Node<ipc::Service>,
+}
+
+/// An agent's mailboxes, on the heap so that the per-tick path (the agent's stack and its link) stays as small as
+/// it was without them: with `ports` (runs with mail), the inbox and outbox of the current tick; without, an empty
+/// inbox and a closed outbox that nothing reads.
+struct Mail {
+    inbox: Mailbox,
+    outbox: Mailbox,
+    ports: Option<MailPorts>,
 }
 
 /// An agent's mail ports (runs with mail only): its inbox entry and its command board's outbox entry. Fields drop
@@ -156,14 +148,12 @@ pub struct AgentLink {
     last_tick: u64,
     /// The robot's frame of the last tick loaded; [`Tick::frame`] lends it out.
     frame: SensorFrame,
+    /// The robot's mailboxes (see [`Mail`]); their ports drop before the node in `ports`.
+    mail: Box<Mail>,
     ports: Ports,
     sync: Arc<SyncBlock>,
     /// Notices the end of the world process, so that waits need no timeout (`None`: no pidfd here).
     world_watch: Option<WorldWatch>,
-    /// The robot's inbox of the last tick it was read in ([`Tick::inbox`]).
-    inbox: Mailbox,
-    /// Whether the agent has said that its messages go nowhere (a run without mail).
-    warned_no_mail: bool,
 }
 
 impl AgentLink {
@@ -193,7 +183,15 @@ impl AgentLink {
             return Err(TransportError::RobotTaken { robot });
         }
         match Self::connect(run, robot, &sync, board_wait) {
-            Ok(ports) => {
+            Ok((ports, mail_ports)) => {
+                let mail = Box::new(Mail {
+                    inbox: Mailbox::empty(robot),
+                    outbox: match mail_ports {
+                        Some(_) => Mailbox::empty(robot),
+                        None => Mailbox::closed(robot),
+                    },
+                    ports: mail_ports,
+                });
                 let placement = sync.placement();
                 if placement.pin_chains {
                     match placement::pin_to_chain_cpu(robot, sync.chain_len()) {
@@ -219,8 +217,7 @@ impl AgentLink {
                     ports,
                     sync,
                     world_watch,
-                    inbox: Mailbox::empty(robot),
-                    warned_no_mail: false,
+                    mail,
                 })
             }
             Err(e) => {
@@ -235,7 +232,7 @@ impl AgentLink {
         robot: u32,
         sync: &SyncBlock,
         board_wait: Duration,
-    ) -> Result<Ports, TransportError> {
+    ) -> Result<(Ports, Option<MailPorts>), TransportError> {
         if sync.is_dead(robot) {
             // A replacement: the dead agent may still hold the writer slot of the robot's current board.
             sync.request_board(robot);
@@ -280,16 +277,16 @@ impl AgentLink {
         } else {
             None
         };
-        Ok(Ports {
+        let ports = Ports {
             frame_entry,
             command_entry,
-            mail,
             _frame_reader: frame_reader,
             _command_writer: command_writer,
             _command_board: command_board,
             _frame_board: frame_board,
             _node: node,
-        })
+        };
+        Ok((ports, mail))
     }
 
     fn connect_inbox(
@@ -333,6 +330,12 @@ impl AgentLink {
             .entry::<T>(&robot)
             .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s entry of {name}"), e))?;
         Ok((board, reader, entry))
+    }
+
+    /// Sends this robot's messages as participant `id` (default: the robot it joined as). A host's agent joins
+    /// its local run as a slot and sends as its run-wide index.
+    pub fn set_sender(&mut self, id: u32) {
+        self.mail.outbox.owner = id;
     }
 
     /// The robot this agent runs.
