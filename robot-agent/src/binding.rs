@@ -185,6 +185,7 @@ mod tests {
 
     impl Profile for Counter {
         const NAME: &'static str = "counter";
+        const TALKS: bool = true;
         const PROCEDURES: &'static [(&'static str, Procedure<Self>)] = &[
             ("seen", Procedure::Check(seen)),
             ("count", Procedure::Act(count)),

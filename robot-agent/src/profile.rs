@@ -43,6 +43,10 @@ pub trait Profile: Sized + Send + 'static {
     /// Event name -> procedure, one entry per event the profile serves.
     const PROCEDURES: &'static [(&'static str, Procedure<Self>)];
 
+    /// Whether the robot talks: only then are [`Profile::receive`] and [`Profile::send`] called. A profile that
+    /// overrides them sets it to true.
+    const TALKS: bool = false;
+
     /// A fresh robot memory with parameters read from `params`.
     fn from_params(params: &Params) -> Result<Self, ParamError>;
 

@@ -33,25 +33,34 @@ trait ProfileCallbacks: EventCallbacks + Talk + Send {}
 impl<T: EventCallbacks + Talk + Send> ProfileCallbacks for T {}
 
 /// Callbacks of a bound profile, whatever its memory type, ready for the player.
-pub struct BoxedCallbacks(Box<dyn ProfileCallbacks>);
+pub struct BoxedCallbacks {
+    callbacks: Box<dyn ProfileCallbacks>,
+    /// The profile's [`Profile::TALKS`]: a profile that does not talk is not called for its messages at all
+    /// (the call would cost an agent a page of code it otherwise never touches, every tick).
+    talks: bool,
+}
 
 impl Talk for BoxedCallbacks {
     fn receive(&mut self, inbox: &Mailbox) {
-        self.0.receive(inbox);
+        if self.talks {
+            self.callbacks.receive(inbox);
+        }
     }
 
     fn send(&mut self, outbox: &mut Mailbox) {
-        self.0.send(outbox);
+        if self.talks {
+            self.callbacks.send(outbox);
+        }
     }
 }
 
 impl EventCallbacks for BoxedCallbacks {
     fn check(&mut self, event: u8, frame: &SensorFrame) -> bool {
-        self.0.check(event, frame)
+        self.callbacks.check(event, frame)
     }
 
     fn act(&mut self, event: u8, frame: &SensorFrame, command: &mut ActuatorCommand) {
-        self.0.act(event, frame, command);
+        self.callbacks.act(event, frame, command);
     }
 }
 
@@ -129,7 +138,10 @@ fn bind_boxed<P: Profile>(
         profile: P::NAME,
         problem,
     })?;
-    Ok(BoxedCallbacks(Box::new(bind(state, events)?)))
+    Ok(BoxedCallbacks {
+        callbacks: Box::new(bind(state, events)?),
+        talks: P::TALKS,
+    })
 }
 
 #[cfg(test)]

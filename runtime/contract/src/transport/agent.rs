@@ -57,6 +57,10 @@ impl Tick<'_> {
     pub fn parts(&mut self) -> (&SensorFrame, &Mailbox, &mut Mailbox) {
         let link = &mut *self.link;
         let mail = &mut *link.mail;
+        if !link.has_mail {
+            // Not even a look at the mailboxes: they are on a page of their own.
+            return (&link.frame, &mail.inbox, &mut mail.outbox);
+        }
         if let Some(ports) = &mail.ports {
             let tick = link.frame.tick;
             mail.inbox.clear();
@@ -78,7 +82,7 @@ impl Tick<'_> {
     pub fn answer(self, command: &mut ActuatorCommand) {
         command.outbox_len = 0;
         let link = &mut *self.link;
-        if let Some(ports) = &link.mail.ports {
+        if let Some(ports) = link.mail.ports.as_ref().filter(|_| link.has_mail) {
             let outbox = &link.mail.outbox;
             if !outbox.is_empty() {
                 let mut posted = *outbox;
@@ -148,6 +152,8 @@ pub struct AgentLink {
     last_tick: u64,
     /// The robot's frame of the last tick loaded; [`Tick::frame`] lends it out.
     frame: SensorFrame,
+    /// Whether the run has mail: read on every tick instead of `mail`, which is on a page of its own.
+    has_mail: bool,
     /// The robot's mailboxes (see [`Mail`]); their ports drop before the node in `ports`.
     mail: Box<Mail>,
     ports: Ports,
@@ -184,6 +190,7 @@ impl AgentLink {
         }
         match Self::connect(run, robot, &sync, board_wait) {
             Ok((ports, mail_ports)) => {
+                let has_mail = mail_ports.is_some();
                 let mail = Box::new(Mail {
                     inbox: Mailbox::empty(robot),
                     outbox: match mail_ports {
@@ -217,6 +224,7 @@ impl AgentLink {
                     ports,
                     sync,
                     world_watch,
+                    has_mail,
                     mail,
                 })
             }
