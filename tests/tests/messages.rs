@@ -110,6 +110,12 @@ fn messages_are_delivered_or_dropped_for_a_reason_and_each_robot_reads_what_was_
         lost * 10 > (lost + delivered) && lost * 10 < 3 * (lost + delivered),
         "{lost} lost, {delivered} delivered"
     );
+    // summary.json counts what messages.csv lists.
+    let summary: serde_json::Value =
+        serde_json::from_str(&text(out.path(), "summary.json")).expect("summary.json");
+    assert_eq!(summary["messages"]["delivered"], delivered);
+    assert_eq!(summary["messages"]["dropped"]["forged_sender"], 40);
+    assert_eq!(summary["messages"]["dropped"]["lost"], lost);
     // Every message delivered after tick k is what its recipient's agent read in tick k + 1: nothing more, nothing
     // less, and nothing to a robot that was not addressed.
     let mut delivered_to: BTreeMap<(u64, u32), u32> = BTreeMap::new();

@@ -228,6 +228,9 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     if let Some(object) = extra.as_object_mut() {
         object.insert("alive_final".into(), faults.alive_count().into());
         object.insert("arrivals".into(), faults.arrivals_summary());
+        if let Some(post) = &post {
+            object.insert("messages".into(), post.summary());
+        }
         if let Some(hosts) = link.summary() {
             object.insert("hosts".into(), hosts);
         }

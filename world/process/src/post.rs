@@ -4,7 +4,7 @@
 
 use swarm_contract::mail::Mailbox;
 use swarm_world::World;
-use swarm_world::media::mail::MessageRecord;
+use swarm_world::media::mail::{MessageRecord, MessageTally};
 use swarm_world::recorder::Recorder;
 
 use crate::faults::FaultDriver;
@@ -16,9 +16,15 @@ pub struct PostOffice {
     inboxes: Vec<Mailbox>,
     up: Vec<bool>,
     records: Vec<MessageRecord>,
+    tally: MessageTally,
 }
 
 impl PostOffice {
+    /// How many messages had each fate so far, for `summary.json`'s `messages`.
+    pub fn summary(&self) -> serde_json::Value {
+        self.tally.to_json()
+    }
+
     /// The post office of a world with a messages medium and `participants` participants; `None` without one.
     pub fn new(world: &World, participants: usize) -> Option<PostOffice> {
         world.has_mail().then(|| PostOffice {
@@ -26,6 +32,7 @@ impl PostOffice {
             inboxes: (0..participants as u32).map(Mailbox::empty).collect(),
             up: vec![false; participants],
             records: Vec::new(),
+            tally: MessageTally::default(),
         })
     }
 
@@ -53,6 +60,7 @@ impl PostOffice {
             &mut self.records,
         );
         recorder.record_messages(&self.records);
+        self.tally.add(&self.records);
         self.records.clear();
         for (participant, inbox) in (0..).zip(self.inboxes.iter_mut()) {
             if !inbox.is_empty() {

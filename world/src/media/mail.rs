@@ -49,6 +49,27 @@ pub enum Fate {
 }
 
 impl Fate {
+    /// Every fate, in the order of [`Fate::index`].
+    pub const ALL: [Fate; 12] = [
+        Fate::Delivered,
+        Fate::ForgedSender,
+        Fate::OverTickLimit,
+        Fate::TooLong,
+        Fate::UnknownRecipient,
+        Fate::BadRange,
+        Fate::NoPosition,
+        Fate::NobodyInRange,
+        Fate::RecipientDown,
+        Fate::OutOfRange,
+        Fate::Lost,
+        Fate::InboxFull,
+    ];
+
+    /// Its place in [`Fate::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
     /// `delivered` or `dropped`, for the records.
     pub fn outcome(self) -> &'static str {
         match self {
@@ -92,6 +113,34 @@ pub struct MessageRecord {
     pub bytes: u16,
     /// What happened.
     pub fate: Fate,
+}
+
+/// How many of a run's decisions had each fate, for `summary.json`.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MessageTally {
+    counts: [u64; Fate::ALL.len()],
+}
+
+impl MessageTally {
+    /// Counts `records`.
+    pub fn add(&mut self, records: &[MessageRecord]) {
+        for record in records {
+            self.counts[record.fate.index()] += 1;
+        }
+    }
+
+    /// `{"delivered": n, "dropped": {"<reason>": n, ...}}`, reasons that never happened left out.
+    pub fn to_json(&self) -> serde_json::Value {
+        let dropped: serde_json::Map<String, serde_json::Value> = Fate::ALL[1..]
+            .iter()
+            .filter(|fate| self.counts[fate.index()] > 0)
+            .map(|fate| (fate.reason().to_owned(), self.counts[fate.index()].into()))
+            .collect();
+        serde_json::json!({
+            "delivered": self.counts[Fate::Delivered.index()],
+            "dropped": dropped,
+        })
+    }
 }
 
 /// Where a participant is and whether it takes part, as the medium needs to know it for one tick.
@@ -387,6 +436,28 @@ mod tests {
         assert_eq!(fates, run());
         let lost = fates.iter().filter(|(_, f)| *f == Fate::Lost).count();
         assert!((50..150).contains(&lost), "{lost} of 200 lost");
+    }
+
+    #[test]
+    fn the_tally_counts_each_fate_under_its_reason() {
+        assert!(
+            Fate::ALL
+                .iter()
+                .enumerate()
+                .all(|(i, fate)| fate.index() == i)
+        );
+        let mut medium = medium(Some(1.0), 0.0);
+        let participants = [robot(0.0), robot(0.5), robot(3.0)];
+        let sent = [outbox(0, &[(Address::All, b"hi")])];
+        let mut inboxes: Vec<Mailbox> = (0..3).map(Mailbox::empty).collect();
+        let mut records = Vec::new();
+        medium.route(1, &sent, &participants, &mut inboxes, &mut records);
+        let mut tally = MessageTally::default();
+        tally.add(&records);
+        assert_eq!(
+            tally.to_json(),
+            serde_json::json!({"delivered": 1, "dropped": {"out_of_range": 1}})
+        );
     }
 
     #[test]
