@@ -77,8 +77,32 @@ impl fmt::Display for Listing<'_> {
     }
 }
 
+/// A synthesised project before it is compiled: everything but the compiled set, which can be too large for the
+/// compact format while the synthesis itself succeeded.
+#[derive(Debug)]
+pub struct Synthesised {
+    /// Every intermediate result of synthesis, for reports, drawings and the supervisors' XML.
+    pub synthesis: Synthesis,
+    /// Validation warnings (never errors).
+    pub warnings: Vec<Diagnostic>,
+}
+
 /// Loads, validates, synthesises and compiles.
 pub fn build(request: &BuildRequest) -> Result<Built, BuildError> {
+    let Synthesised {
+        synthesis,
+        warnings,
+    } = synthesise(request)?;
+    let set = synthesis.compile()?;
+    Ok(Built {
+        synthesis,
+        set,
+        warnings,
+    })
+}
+
+/// Loads, validates and synthesises, without compiling.
+pub fn synthesise(request: &BuildRequest) -> Result<Synthesised, BuildError> {
     let plants = request
         .plants
         .iter()
@@ -108,10 +132,8 @@ pub fn build(request: &BuildRequest) -> Result<Built, BuildError> {
             ..SynthesisOptions::default()
         },
     )?;
-    let set = synthesis.compile()?;
-    Ok(Built {
+    Ok(Synthesised {
         synthesis,
-        set,
         warnings: validation.diagnostics,
     })
 }

@@ -217,6 +217,12 @@ impl Default for Images {
     }
 }
 
+/// Largest automaton drawn at all (in states): a DOT file of more states is too large to read or lay out.
+pub const MAX_DOT_STATES: usize = 50_000;
+/// Largest automaton Graphviz is asked to render (in states): its layout of a few thousand states already takes
+/// minutes, of a million hours; above this only the DOT file is written.
+pub const MAX_IMAGE_STATES: usize = 2_000;
+
 /// Writes `dot` to `dir/<stem>.dot` and, when Graphviz is available, renders the requested images next to it.
 /// Returns every file written.
 pub fn write_drawing(

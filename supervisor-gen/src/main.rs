@@ -13,14 +13,14 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use supervisor_gen::architecture::Architecture;
 use supervisor_gen::automaton::{Automaton, EventTable, ModelKind, StateId};
-use supervisor_gen::build::{BuildError, BuildRequest, Built, build};
+use supervisor_gen::build::{BuildError, BuildRequest, Built, Synthesised, build, synthesise};
 use supervisor_gen::codegen::generate_rust;
 use supervisor_gen::convert::to_automata;
 use supervisor_gen::diagnostics::{Diagnostic, Severity};
 use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels, StateMark};
 use supervisor_gen::load::{Input, load};
 use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
-use supervisor_gen::report::Report;
+use supervisor_gen::report::{Report, SkippedOutput};
 use supervisor_gen::supc::RemovalReason;
 use supervisor_gen::validate::{CheckedModel, ValidateOptions};
 use supervisor_gen::xml_write::to_xml;
@@ -277,10 +277,11 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
     };
     let (events, automata) = to_automata(&models)?;
     create_dir(&args.out)?;
-    let drawer = Drawer {
+    let mut drawer = Drawer {
         dir: &args.out,
         events: &events,
         images: args.images.images(),
+        skipped: Vec::new(),
     };
     let mut written = 0;
     for a in &automata {
@@ -297,34 +298,60 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
         "{written} drawing file(s) written to {}",
         args.out.display()
     );
+    for s in &drawer.skipped {
+        eprintln!("warning: {} not written: {}", s.output, s.reason);
+    }
     Ok(Outcome::Success)
 }
 
-/// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
-/// specification impossible or the result too large to compile. I/O problems are errors.
-fn built(args: &ProjectArgs) -> Result<Option<Built>> {
-    let request = BuildRequest {
+/// The build request of a project's arguments.
+fn request(args: &ProjectArgs) -> BuildRequest {
+    BuildRequest {
         plants: args.plants.clone(),
         specs: args.specs.clone(),
         architecture: args.mode.into(),
         raw_weights: args.raw_weights,
         thesis_literal_probabilities: args.thesis_literal_probabilities,
-    };
-    match build(&request) {
+    }
+}
+
+/// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
+/// specification impossible or the result too large to compile. I/O problems are errors.
+fn built(args: &ProjectArgs) -> Result<Option<Built>> {
+    match build(&request(args)) {
         Ok(built) => {
             print_diagnostics(&built.warnings);
             Ok(Some(built))
         }
-        Err(BuildError::Load(err)) => Err(err.into()),
-        Err(BuildError::Invalid(diagnostics)) => {
+        Err(err) => refused(err),
+    }
+}
+
+/// Synthesises a project without compiling it; `None` (with every diagnostic or the reason printed) if the input
+/// is invalid or the specification impossible. I/O problems are errors.
+fn synthesised(args: &ProjectArgs) -> Result<Option<Synthesised>> {
+    match synthesise(&request(args)) {
+        Ok(synthesised) => {
+            print_diagnostics(&synthesised.warnings);
+            Ok(Some(synthesised))
+        }
+        Err(err) => refused(err),
+    }
+}
+
+/// Prints why a project was refused (`None`), or passes an I/O problem on.
+fn refused<T>(err: BuildError) -> Result<Option<T>> {
+    match err {
+        BuildError::Load(err) => Err(err.into()),
+        BuildError::Invalid(diagnostics) => {
             print_diagnostics(&diagnostics);
             Ok(None)
         }
-        Err(BuildError::Codegen(err)) => {
+        BuildError::Codegen(err) => {
             eprintln!("error[V15]: {err}");
             Ok(None)
         }
-        Err(err) => {
+        err => {
             eprintln!("error: {err}");
             Ok(None)
         }
@@ -347,11 +374,10 @@ fn codegen(args: &CodegenArgs) -> Result<Outcome> {
 }
 
 fn synth(args: &SynthArgs) -> Result<Outcome> {
-    let Some(Built {
+    let Some(Synthesised {
         synthesis,
-        set,
         warnings,
-    }) = built(&args.project)?
+    }) = synthesised(&args.project)?
     else {
         return Ok(Outcome::Rejected);
     };
@@ -364,28 +390,53 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
         write(&out.join(&file), to_xml(&s.supervisor, events))?;
         files.push(file);
     }
-    let bytes = set.to_bytes();
-    write(&out.join("supervisors.ptsct"), &bytes)?;
-    write(
-        &out.join("supervisors.rs"),
-        generate_rust(&set, &origin(&args.project, synthesis.architecture)),
-    )?;
-    let report = Report::new(&synthesis, &files, bytes.len(), &warnings);
+    // A result is never lost: a set too large for the compiled format skips only the compiled outputs.
+    let mut skipped = Vec::new();
+    let (bytes_written, mem_cons) = match synthesis.compile() {
+        Ok(set) => {
+            let bytes = set.to_bytes();
+            write(&out.join("supervisors.ptsct"), &bytes)?;
+            write(
+                &out.join("supervisors.rs"),
+                generate_rust(&set, &origin(&args.project, synthesis.architecture)),
+            )?;
+            (bytes.len(), set.mem_cons())
+        }
+        Err(err) => {
+            for output in ["supervisors.ptsct", "supervisors.rs"] {
+                skipped.push(SkippedOutput {
+                    output: output.to_owned(),
+                    reason: format!("V15: {err}"),
+                });
+            }
+            (0, synthesis.mem_cons)
+        }
+    };
+    if args.draw {
+        let dir = out.join("drawings");
+        create_dir(&dir)?;
+        let mut drawer = Drawer {
+            dir: &dir,
+            events,
+            images: args.images.images(),
+            skipped: Vec::new(),
+        };
+        draw_synthesis(&mut drawer, &synthesis)?;
+        skipped.extend(drawer.skipped.into_iter().map(|s| SkippedOutput {
+            output: format!("drawings/{}", s.output),
+            ..s
+        }));
+    }
+    let mut report = Report::new(&synthesis, &files, bytes_written, &warnings);
+    report.skipped = skipped;
     write(
         &out.join("report.json"),
         report.to_json().context("cannot serialise the report")?,
     )?;
-    if args.draw {
-        let dir = out.join("drawings");
-        create_dir(&dir)?;
-        let drawer = Drawer {
-            dir: &dir,
-            events,
-            images: args.images.images(),
-        };
-        draw_synthesis(&drawer, &synthesis)?;
+    print_summary(&synthesis, mem_cons, out);
+    for s in &report.skipped {
+        eprintln!("warning: {} not written: {}", s.output, s.reason);
     }
-    print_summary(&synthesis, set.mem_cons(), out);
     Ok(Outcome::Success)
 }
 
@@ -449,7 +500,7 @@ fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
 
 /// Draws the project's inputs (once, into `inputs/`), every intermediate stage of every supervisor (into
 /// `stages/`) and the final supervisors (at the top, apart from the rest).
-fn draw_synthesis(drawer: &Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
+fn draw_synthesis(drawer: &mut Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
     let project = &synthesis.normalised;
     for a in project.plants.iter().chain(&project.specs) {
         let stem = format!("inputs/{}", dot::file_stem(a.name()));
@@ -466,7 +517,7 @@ fn draw_synthesis(drawer: &Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
 }
 
 /// G, E, K (with the removed states marked), SupC before minimisation, and the final supervisor.
-fn draw_stages(drawer: &Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
+fn draw_stages(drawer: &mut Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
     let stem = dot::file_stem(&s.name);
     let removed: HashMap<StateId, StateMark> = s
         .removed
@@ -495,24 +546,55 @@ fn draw_stages(drawer: &Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
     Ok(())
 }
 
-/// Writes drawings of automata over one event table into one directory.
+/// Writes drawings of automata over one event table into one directory, and notes the drawings it leaves out.
 struct Drawer<'a> {
     dir: &'a Path,
     events: &'a EventTable,
     images: Images,
+    /// Drawings (or their images) not written because the automaton is too large, relative to `dir`.
+    skipped: Vec<SkippedOutput>,
 }
 
 impl Drawer<'_> {
-    /// Writes one drawing; returns the number of files written.
+    /// Writes one drawing; returns the number of files written. An automaton of more than
+    /// [`dot::MAX_DOT_STATES`] states is not drawn, and one of more than [`dot::MAX_IMAGE_STATES`] gets its DOT
+    /// file but no images: both are noted in `skipped`.
     fn draw(
-        &self,
+        &mut self,
         stem: &str,
         a: &Automaton,
         marks: &HashMap<StateId, StateMark>,
         probs: ProbLabels,
     ) -> Result<usize> {
+        let states = a.state_count();
+        if states > dot::MAX_DOT_STATES {
+            self.skipped.push(SkippedOutput {
+                output: format!("{stem}.dot"),
+                reason: format!(
+                    "{states} states, more than the {} drawn at all",
+                    dot::MAX_DOT_STATES
+                ),
+            });
+            return Ok(0);
+        }
         let text = dot::to_dot(a, self.events, marks, probs);
-        let written = dot::write_drawing(self.dir, stem, &text, &self.images)
+        let no_images = Images {
+            formats: Vec::new(),
+            dpi: None,
+        };
+        let images = if states > dot::MAX_IMAGE_STATES && !self.images.formats.is_empty() {
+            self.skipped.push(SkippedOutput {
+                output: format!("{stem} images"),
+                reason: format!(
+                    "{states} states, more than the {} Graphviz is asked to lay out; the DOT file is written",
+                    dot::MAX_IMAGE_STATES
+                ),
+            });
+            &no_images
+        } else {
+            &self.images
+        };
+        let written = dot::write_drawing(self.dir, stem, &text, images)
             .with_context(|| format!("cannot write drawing {stem} in {}", self.dir.display()))?;
         Ok(written.len())
     }

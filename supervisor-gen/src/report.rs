@@ -29,6 +29,18 @@ pub struct Report {
     pub architecture_checks: ArchitectureChecks,
     /// Every validation warning (code, severity, file, line, column, message).
     pub warnings: Vec<Diagnostic>,
+    /// Outputs that were not written, and why (a supervisor set too large for the compiled format, a drawing
+    /// too large to draw); empty when everything was written.
+    pub skipped: Vec<SkippedOutput>,
+}
+
+/// An output that was not written.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SkippedOutput {
+    /// The file, relative to the output directory.
+    pub output: String,
+    /// Why it was not written.
+    pub reason: String,
 }
 
 /// One supervisor.
@@ -231,6 +243,7 @@ impl Report {
                 .filter(|d| !d.is_error())
                 .cloned()
                 .collect(),
+            skipped: Vec::new(),
         }
     }
 

@@ -482,3 +482,94 @@ fn a_device_or_a_deeply_nested_file_is_refused_with_its_name_not_read_forever_or
         stderr(&o)
     );
 }
+
+/// Writes a plant that may always do `event` and a specification that is a cycle of `states` states over it, only
+/// the first marked (no two of its states can be merged); returns their paths.
+fn write_cycle(dir: &Path, event: &str, states: usize) -> (PathBuf, PathBuf) {
+    let plant = dir.join(format!("clock_{event}.xml"));
+    std::fs::write(
+        &plant,
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<automata name="clock_{event}" type="plant">
+  <states><state name="on" i="1" m="1"/></states>
+  <events><event name="{event}" con="1"/></events>
+  <transitions><transition src="on" dst="on" event="{event}"/></transitions>
+</automata>
+"#
+        ),
+    )
+    .expect("writes the plant");
+    let mut spec = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<automata name=\"cycle_{event}\" type=\"spec\">\n  <states>\n"
+    );
+    spec.push_str("    <state name=\"s0\" i=\"1\" m=\"1\"/>\n");
+    for k in 1..states {
+        spec.push_str(&format!("    <state name=\"s{k}\"/>\n"));
+    }
+    spec.push_str(&format!(
+        "  </states>\n  <events><event name=\"{event}\" con=\"1\"/></events>\n  <transitions>\n"
+    ));
+    for k in 0..states {
+        spec.push_str(&format!(
+            "    <transition src=\"s{k}\" dst=\"s{}\" event=\"{event}\"/>\n",
+            (k + 1) % states
+        ));
+    }
+    spec.push_str("  </transitions>\n</automata>\n");
+    let spec_path = dir.join(format!("cycle_{event}.xml"));
+    std::fs::write(&spec_path, spec).expect("writes the specification");
+    (plant, spec_path)
+}
+
+#[test]
+fn a_supervisor_too_large_to_compile_still_gives_its_xml_report_and_drawings_and_exit_0() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Two independent cycles of 300 and 250 states: the monolithic supervisor is their product, 75,000 states,
+    // more than the compiled format's 65,535.
+    let (plant_a, spec_a) = write_cycle(dir.path(), "a", 300);
+    let (plant_b, spec_b) = write_cycle(dir.path(), "b", 250);
+    let out = dir.path().join("out");
+    let o = run(&[
+        "synth",
+        "--plant",
+        path(&plant_a),
+        path(&plant_b),
+        "--spec",
+        path(&spec_a),
+        path(&spec_b),
+        "--mode",
+        "monolithic",
+        "--draw",
+        "--out",
+        path(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let warnings = stderr(&o);
+    assert!(
+        warnings.contains("warning: supervisors.ptsct not written: V15:")
+            && warnings.contains("65535"),
+        "{warnings}"
+    );
+    assert!(!out.join("supervisors.ptsct").exists());
+    assert!(!out.join("supervisors.rs").exists());
+    let xml =
+        std::fs::read_to_string(out.join("S_mon.xml")).expect("the supervisor's XML is written");
+    let supervisor = read_model("S_mon.xml", &xml, None).expect("readable");
+    assert_eq!(supervisor.states.len(), 75_000);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("report"))
+            .expect("JSON");
+    let skipped: Vec<&str> = report["skipped"]
+        .as_array()
+        .expect("skipped")
+        .iter()
+        .filter_map(|s| s["output"].as_str())
+        .collect();
+    assert!(skipped.contains(&"supervisors.ptsct") && skipped.contains(&"supervisors.rs"));
+    // The 75,000-state automata are too large to draw; the inputs are drawn (the 300-state cycle without images).
+    assert!(skipped.contains(&"drawings/S_mon.dot"), "{skipped:?}");
+    assert!(out.join("drawings/inputs/clock_a.dot").is_file());
+    assert!(out.join("drawings/inputs/cycle_a.dot").is_file());
+    assert!(!out.join("drawings/S_mon.dot").exists());
+}
