@@ -318,22 +318,26 @@ fn request(args: &ProjectArgs) -> BuildRequest {
 /// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
 /// specification impossible or the result too large to compile. I/O problems are errors.
 fn built(args: &ProjectArgs) -> Result<Option<Built>> {
-    match build(&request(args)) {
-        Ok(built) => {
-            print_diagnostics(&built.warnings);
-            Ok(Some(built))
-        }
-        Err(err) => refused(err),
-    }
+    accepted(build(&request(args)), |built| &built.warnings)
 }
 
 /// Synthesises a project without compiling it; `None` (with every diagnostic or the reason printed) if the input
 /// is invalid or the specification impossible. I/O problems are errors.
 fn synthesised(args: &ProjectArgs) -> Result<Option<Synthesised>> {
-    match synthesise(&request(args)) {
-        Ok(synthesised) => {
-            print_diagnostics(&synthesised.warnings);
-            Ok(Some(synthesised))
+    accepted(synthesise(&request(args)), |synthesised| {
+        &synthesised.warnings
+    })
+}
+
+/// The result with its validation `warnings` printed, or why it was refused.
+fn accepted<T>(
+    result: Result<T, BuildError>,
+    warnings: fn(&T) -> &[Diagnostic],
+) -> Result<Option<T>> {
+    match result {
+        Ok(value) => {
+            print_diagnostics(warnings(&value));
+            Ok(Some(value))
         }
         Err(err) => refused(err),
     }
