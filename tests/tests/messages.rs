@@ -163,6 +163,10 @@ fn a_coordinator_answers_robots_and_the_run_goes_on_while_it_is_killed_and_resta
     let summary: serde_json::Value =
         serde_json::from_str(&text(out, "summary.json")).expect("summary.json");
     assert_eq!(summary["robots"], 4);
+    assert_eq!(
+        summary["alive_final"], 4,
+        "robots taking part; the coordinator is not one"
+    );
     assert_eq!(summary["coordinators"][0]["id"], "central");
     assert_eq!(summary["coordinators"][0]["index"], CENTRAL);
     let fault = &summary["faults"][0];

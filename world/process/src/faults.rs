@@ -205,9 +205,14 @@ impl FaultDriver {
         self.arrivals.summary()
     }
 
-    /// Robots taking part.
+    /// Robots taking part (coordinators, the participants after the robots, are not counted).
     pub fn alive_count(&self) -> usize {
-        self.robots.iter().filter(|r| **r == Robot::Alive).count()
+        // The random-pick mask has one place per robot.
+        let robots = self.alive_mask.len();
+        self.robots[..robots]
+            .iter()
+            .filter(|r| **r == Robot::Alive)
+            .count()
     }
 
     /// Waits until every robot has an agent, except those killed at start-up. Locally the launcher kills those

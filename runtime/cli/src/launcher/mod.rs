@@ -884,7 +884,10 @@ impl Supervision {
             world_pid,
             agent_pids,
             faults: self.faults.clone(),
-            alive_final: self.robots.iter().filter(|r| r.is_alive()).count() as u32,
+            alive_final: self.robots[..robots as usize]
+                .iter()
+                .filter(|r| r.is_alive())
+                .count() as u32,
         }
     }
 }
