@@ -349,17 +349,12 @@ pub fn build(
     b.loop_functions(registry.create(params.as_ref())?);
     let mut world = b.build();
     world.set_max_ticks(exp.framework.max_ticks());
-    // Robots that join later wait outside the arena; they keep the pose they were given to join at.
+    // Robots that join later wait outside the arena; they keep the pose they were given to join at. When they
+    // join is the world process's business (its arrivals).
     for robot in exp.arena.robots() {
-        let id = crate::entities::RobotId(robot.index);
-        match robot.entity.arrival {
-            config::Arrival::Start => continue,
-            config::Arrival::At(at) => {
-                world.schedule_join(at.tick(exp.framework.ticks_per_second).max(1), id);
-            }
-            config::Arrival::Spare => {}
+        if robot.entity.arrival != config::Arrival::Start {
+            world.park(crate::entities::RobotId(robot.index));
         }
-        world.park(id);
     }
     Ok(world)
 }

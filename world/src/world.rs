@@ -291,7 +291,6 @@ impl WorldBuilder {
             mail: self.mail,
             participants: Vec::new(),
             coordinators: self.coordinators,
-            join_schedule: Vec::new(),
         };
         world.update_media();
         world
@@ -317,8 +316,6 @@ pub struct World {
     participants: Vec<Participant>,
     /// The participants after the robots, which have no body.
     coordinators: Vec<Coordinator>,
-    /// The robots that join mid-run by schedule, with their tick, in tick order.
-    join_schedule: Vec<(u64, RobotId)>,
 }
 
 impl World {
@@ -477,17 +474,6 @@ impl World {
         );
         self.leds
             .rebuild(&self.arena.robots, &self.arena.targets, &self.arena.lights);
-    }
-
-    /// Schedules the absent `robot` to join at `tick` (see [`World::join`]; the world process carries it out).
-    pub fn schedule_join(&mut self, tick: u64, robot: RobotId) {
-        let at = self.join_schedule.partition_point(|&(t, _)| t <= tick);
-        self.join_schedule.insert(at, (tick, robot));
-    }
-
-    /// The robots that join mid-run by schedule, with their tick, in tick order.
-    pub fn join_schedule(&self) -> &[(u64, RobotId)] {
-        &self.join_schedule
     }
 
     /// Takes `robot` out of the arena: it is not in the run (before it joins, or after it left). Its body

@@ -141,7 +141,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         args.out.clone(),
         &limits,
     )?
-    .with_arrivals(faults::Arrivals::new(&world, &experiment));
+    .with_arrivals(faults::Arrivals::new(&experiment));
     let mut recorder = Recorder::create(&args.out, &world, &[0])?;
     let mut post = PostOffice::new(&world, link.robots());
     recorder.record(&mut world)?;

@@ -48,7 +48,10 @@ impl PostOffice {
         self.outboxes.clear();
         for (participant, up) in self.up.iter_mut().enumerate() {
             *up = faults.is_alive(participant);
-            if let Some(outbox) = link.outbox(participant as u32).filter(|_| *up) {
+            if !*up {
+                continue;
+            }
+            if let Some(outbox) = link.outbox(participant as u32) {
                 self.outboxes.push(outbox);
             }
         }

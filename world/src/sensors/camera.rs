@@ -4,7 +4,7 @@
 //! LEDs within 0.35 m, the foot-bot those inside its camera's cone (`swarm_contract::bodies::CameraView`).
 
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
+use rand_distr::Distribution;
 use swarm_contract::messages::{CameraBlob, SensorFrame};
 
 use crate::devices::CameraOptions;
@@ -34,9 +34,7 @@ pub fn sense(
     } = observer;
     let camera_height = body.camera_height;
     let mut len = 0usize;
-    let noise = (options.noise_std_dev > 0.0)
-        .then(|| Normal::new(0.0f32, options.noise_std_dev).ok())
-        .flatten();
+    let noise = super::noise::normal(options.noise_std_dev);
     leds.near(position, body.camera_reach(), |led| {
         if led.owner == Some(BodyRef::Robot(me)) || led.height >= camera_height {
             return;

@@ -14,11 +14,16 @@ pub fn uniform(level: f32, rng: &mut ChaCha8Rng, values: &mut [f32]) {
     }
 }
 
+/// The distribution of Gaussian noise of `std_dev`; `None` when there is none (0) or it cannot be (not finite).
+pub fn normal(std_dev: f32) -> Option<Normal<f32>> {
+    (std_dev > 0.0)
+        .then(|| Normal::new(0.0f32, std_dev).ok())
+        .flatten()
+}
+
 /// `v <- clamp(v + N(0, std_dev), 0, 1)` for every value; nothing is drawn when `std_dev` is 0.
 pub fn gaussian(std_dev: f32, rng: &mut ChaCha8Rng, values: &mut [f32]) {
-    if std_dev > 0.0
-        && let Ok(normal) = Normal::new(0.0f32, std_dev)
-    {
+    if let Some(normal) = normal(std_dev) {
         for v in values.iter_mut() {
             *v = (*v + normal.sample(rng)).clamp(0.0, 1.0);
         }

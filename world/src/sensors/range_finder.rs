@@ -4,7 +4,7 @@
 //! mounted above the tallest robot would not; see docs/robots.md.
 
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
+use rand_distr::Distribution;
 
 use crate::devices::RangeFinderOptions;
 use crate::geometry::{Vec2, unit};
@@ -32,9 +32,7 @@ pub fn sense(
     // A long range spans many grid cells, so the same body comes back many times; each ray would test it again.
     scratch.sort_unstable();
     scratch.dedup();
-    let noise = (options.noise_std_dev > 0.0)
-        .then(|| Normal::new(0.0f32, options.noise_std_dev).ok())
-        .flatten();
+    let noise = super::noise::normal(options.noise_std_dev);
     let step = std::f32::consts::TAU / out.len().max(1) as f32;
     for (i, value) in out.iter_mut().enumerate() {
         let dir: Vec2 = unit(heading + step * i as f32);

@@ -427,8 +427,10 @@ impl WorldLink {
             let robots = chain.start as usize..chain.end as usize;
             let frames = &mut self.frames[robots.clone()];
             SensorFrame::sense_into(tick, robots.start, frames, &mut sense);
-            for (frame, &posted) in frames.iter_mut().zip(&self.posted[robots.clone()]) {
-                frame.inbox_len = posted;
+            if self.config.mail {
+                for (frame, &posted) in frames.iter_mut().zip(&self.posted[robots.clone()]) {
+                    frame.inbox_len = posted;
+                }
             }
             for (frame, entry) in frames.iter().zip(&self.boards.frame_entries[robots]) {
                 entry.update_with_copy(*frame);
@@ -447,7 +449,9 @@ impl WorldLink {
             tracing::debug!(tick, "tick deadline passed with answers missing");
         }
         let outcome = self.collect(tick);
-        self.posted.fill(0);
+        if self.config.mail {
+            self.posted.fill(0);
+        }
         self.cleanup_if_due(tick);
         Ok(outcome)
     }

@@ -8,7 +8,7 @@
 //! robot, reports `left k r`, and the launcher stops its agent. Each is an `events.csv` row (`join`,
 //! `join:refused`, `leave`) and an entry of `summary.json`'s `arrivals`.
 
-use swarm_contract::config::Experiment;
+use swarm_contract::config::{Arrival, Experiment};
 use swarm_contract::messages::SupervisorSnapshot;
 use swarm_contract::protocol::launcher_to_world::SpawnPose;
 use swarm_contract::protocol::world_to_launcher::WorldReport;
@@ -53,19 +53,26 @@ pub struct Arrivals {
 }
 
 impl Arrivals {
-    /// The arrivals of `world`'s run, built from `experiment`: its join schedule, nothing asked yet.
-    pub fn new(world: &World, experiment: &Experiment) -> Arrivals {
+    /// The arrivals of `experiment`'s run: the robots that join by schedule (`join_tick`, `join_time`), nothing
+    /// asked yet.
+    pub fn new(experiment: &Experiment) -> Arrivals {
+        let participants = experiment.participants();
+        let ticks_per_second = experiment.framework.ticks_per_second;
+        let mut schedule: Vec<(u64, u32)> = participants
+            .iter()
+            .filter_map(|p| match p.arrival {
+                Arrival::At(at) => Some((at.tick(ticks_per_second).max(1), p.index)),
+                Arrival::Start | Arrival::Spare => None,
+            })
+            .collect();
+        // Stable: robots due at one tick join in index order.
+        schedule.sort_by_key(|&(tick, _)| tick);
         Arrivals {
-            schedule: world
-                .join_schedule()
-                .iter()
-                .map(|&(tick, robot)| (tick, robot.0))
-                .collect(),
+            schedule,
             spawns: Vec::new(),
             removals: Vec::new(),
             log: Vec::new(),
-            declared: experiment
-                .participants()
+            declared: participants
                 .iter()
                 .map(|p| format!("{}:{}", experiment.path.display(), p.location))
                 .collect(),
@@ -158,20 +165,23 @@ impl FaultDriver {
             .get(robot as usize)
             .map(|r| r.name.clone())
             .unwrap_or_default();
-        let wanted = pose.map(|p| {
-            let heading = p.heading_deg.map_or_else(
-                || world.arena.robots[robot as usize].heading,
-                f32::to_radians,
-            );
-            (Vec2::new(p.x, p.y), heading)
-        });
         let placed = match self.robots.get(robot as usize) {
-            Some(Robot::Absent) => world
-                .join(RobotId(robot), wanted)
-                .map_err(|refused| match self.arrivals.declared.get(robot as usize) {
-                    Some(at) => format!("{at}: robot '{id}': {}", refused.0),
-                    None => refused.0,
-                }),
+            Some(Robot::Absent) => {
+                // Only robots are ever absent, so `robot` is one of the arena's.
+                let wanted = pose.map(|p| {
+                    let heading = p.heading_deg.map_or_else(
+                        || world.arena.robots[robot as usize].heading,
+                        f32::to_radians,
+                    );
+                    (Vec2::new(p.x, p.y), heading)
+                });
+                world.join(RobotId(robot), wanted).map_err(|refused| {
+                    match self.arrivals.declared.get(robot as usize) {
+                        Some(at) => format!("{at}: robot '{id}': {}", refused.0),
+                        None => refused.0,
+                    }
+                })
+            }
             Some(_) => Err(format!("robot {robot} is in the run already")),
             None => Err(format!("there is no robot {robot}")),
         };
