@@ -625,14 +625,19 @@ impl LiveSwarm {
         live
     }
 
-    /// Reads the launcher's log up to the first line containing `needle` and returns that line.
-    pub fn wait_for(&mut self, needle: &str) -> String {
+    /// The launcher's next log line (the launcher must not have ended).
+    pub fn next_line(&mut self) -> String {
         use std::io::BufRead;
         let mut line = String::new();
+        let read = self.log.read_line(&mut line).expect("the launcher's log");
+        assert!(read > 0, "the launcher ended early");
+        line
+    }
+
+    /// Reads the launcher's log up to the first line containing `needle` and returns that line.
+    pub fn wait_for(&mut self, needle: &str) -> String {
         loop {
-            line.clear();
-            let read = self.log.read_line(&mut line).expect("the launcher's log");
-            assert!(read > 0, "the launcher ended before logging `{needle}`");
+            let line = self.next_line();
             if line.contains(needle) {
                 return line;
             }

@@ -2,15 +2,11 @@
 //! world process, real signals. Every test asserts on the records (`trajectory.csv`, `events.csv`,
 //! `summary.json`, agent logs), never on timing, and checks that nothing of its run is left behind.
 
-use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, ChildStderr};
 
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
-use swarm_system_tests::{
-    SwarmOutcome, assert_nothing_left, remove_run_leftovers, spawn_swarm, swarm, swarm_ctl,
-};
+use swarm_system_tests::{LiveSwarm, SwarmOutcome, assert_nothing_left, swarm, swarm_ctl};
 
 const OBSTACLE_AVOIDANCE: &str = "configs/obstacle_avoidance/obstacle_avoidance.argos";
 const ROBOTS: usize = 40;
@@ -378,8 +374,7 @@ fn same_seed_and_fault_schedule_give_identical_records() {
 /// Dropping it unfinished (a failed assertion) kills the launcher, whose children die with it, and removes the
 /// run's shared memory.
 struct LiveRun {
-    child: Child,
-    stderr: BufReader<ChildStderr>,
+    live: LiveSwarm,
     out: tempfile::TempDir,
 }
 
@@ -402,15 +397,10 @@ impl LiveRun {
             out_arg.as_str(),
         ];
         args.extend(extra);
-        let mut child = spawn_swarm(&args);
-        let mut stderr = BufReader::new(child.stderr.take().expect("stderr is piped"));
-        let mut line = String::new();
-        while stderr.read_line(&mut line).expect("the launcher's log") > 0
-            && !line.contains("first tick completed")
-        {
-            line.clear();
+        LiveRun {
+            live: LiveSwarm::start(&args),
+            out,
         }
-        LiveRun { child, stderr, out }
     }
 
     /// Runs `swarm ctl <out> <request>` and returns its standard output.
@@ -430,43 +420,17 @@ impl LiveRun {
 
     /// The launcher's next log line.
     fn next_log_line(&mut self) -> String {
-        let mut line = String::new();
-        let read = self
-            .stderr
-            .read_line(&mut line)
-            .expect("the launcher's log");
-        assert!(read > 0, "the launcher ended early");
-        line
+        self.live.next_line()
     }
 
     /// Interrupts the run, checks it ended cleanly and left nothing, and returns its summary.
-    fn stop(mut self) -> serde_json::Value {
-        let pid = self.child.id();
-        kill(Pid::from_raw(pid as i32), Signal::SIGINT).expect("interrupt the launcher");
-        let mut rest = String::new();
-        while self.stderr.read_line(&mut rest).unwrap_or(0) > 0 {}
-        let status = self.child.wait().expect("the launcher exits");
-        assert_eq!(
-            status.code(),
-            Some(130),
-            "an interrupted run exits 130:\n{rest}"
-        );
-        assert_nothing_left(pid);
+    fn stop(self) -> serde_json::Value {
+        self.live.interrupt();
         assert!(
             !self.out.path().join("control.sock").exists(),
             "the control socket is removed"
         );
         summary(self.out.path())
-    }
-}
-
-impl Drop for LiveRun {
-    fn drop(&mut self) {
-        if let Ok(None) = self.child.try_wait() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-            remove_run_leftovers(&format!("sw{:x}-", self.child.id()));
-        }
     }
 }
 

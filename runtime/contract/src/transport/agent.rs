@@ -81,24 +81,18 @@ impl Tick<'_> {
     #[unsafe(link_section = "swarm_hot")]
     pub fn answer(self, command: &mut ActuatorCommand) {
         command.outbox_len = 0;
-        let link = &mut *self.link;
+        let link = self.link;
+        let tick = link.frame.tick;
         if let Some(ports) = link.mail.ports.as_ref().filter(|_| link.has_mail) {
             let outbox = &link.mail.outbox;
             if !outbox.is_empty() {
                 let mut posted = *outbox;
-                posted.tick = link.frame.tick;
+                posted.tick = tick;
                 posted.owner = link.robot;
                 ports.outbox.update_with_copy(posted);
                 command.outbox_len = outbox.messages().len() as u8;
             }
         }
-        self.send_answer(command);
-    }
-
-    #[unsafe(link_section = "swarm_hot")]
-    fn send_answer(self, command: &mut ActuatorCommand) {
-        let link = self.link;
-        let tick = link.frame.tick;
         command.tick = tick;
         command.robot = link.robot;
         link.ports.command_entry.update_with_copy(*command);
