@@ -115,6 +115,18 @@ pub struct Arena {
 }
 
 impl Arena {
+    /// Moves `robot` to `position` facing `heading` (radians), at rest; for loop functions placing robots
+    /// before the run.
+    pub fn place_robot(&mut self, robot: crate::entities::RobotId, position: Vec2, heading: f32) {
+        let Some(r) = self.robots.get_mut(robot.index()) else {
+            return;
+        };
+        r.position = position;
+        r.heading = heading;
+        r.wheels = [0.0; 2];
+        self.physics.teleport(r.handles.body, position, heading);
+    }
+
     /// Simulated seconds per tick.
     pub fn dt(&self) -> f32 {
         1.0 / self.ticks_per_second as f32

@@ -348,6 +348,7 @@ pub fn build(
         .map(|lf| loop_functions_params(exp, lf, seed));
     b.loop_functions(registry.create(params.as_ref())?);
     let mut world = b.build();
+    world.place_by_loop_functions()?;
     world.set_max_ticks(exp.framework.max_ticks());
     // Robots that join later wait outside the arena; they keep the pose they were given to join at. When they
     // join is the world process's business (its arrivals).

@@ -10,7 +10,7 @@ use swarm_contract::bodies::{BodyModel, CameraView, EPUCK};
 use swarm_contract::config::Experiment;
 use swarm_contract::config::MessagesMedium;
 use swarm_contract::config::faults::DeadBodies;
-use swarm_contract::mail::Mailbox;
+use swarm_contract::mail::{Mail, Mailbox};
 use swarm_contract::messages::{ActuatorCommand, PHEROMONE_CHANNELS, SensorFrame};
 
 use crate::actuators;
@@ -291,6 +291,7 @@ impl WorldBuilder {
             mail: self.mail,
             participants: Vec::new(),
             coordinators: self.coordinators,
+            letters: Vec::new(),
         };
         world.update_media();
         world
@@ -316,6 +317,8 @@ pub struct World {
     participants: Vec<Participant>,
     /// The participants after the robots, which have no body.
     coordinators: Vec<Coordinator>,
+    /// What the loop functions send this tick, refilled each tick.
+    letters: Vec<Mail>,
 }
 
 impl World {
@@ -402,6 +405,17 @@ impl World {
             },
         ));
         mail.route(tick, outboxes, &self.participants, inboxes, records);
+        self.letters.clear();
+        self.loop_functions
+            .post_mail(&self.arena, &mut self.letters);
+        mail.post_letters(tick, &self.letters, &self.participants, inboxes, records);
+    }
+
+    /// Lets the loop functions move robots to where the task wants them before the first tick.
+    pub fn place_by_loop_functions(&mut self) -> Result<(), WorldError> {
+        self.loop_functions.place(&mut self.arena)?;
+        self.index_bodies();
+        Ok(())
     }
 
     /// The task metrics of the loop functions.

@@ -10,6 +10,7 @@ pub mod footbot_foraging;
 pub mod footbot_gripping;
 pub mod footbot_synchronization;
 pub mod mail_probe;
+pub mod navigation_coordinator;
 pub mod sensor_probe;
 
 use swarm_contract::mail::Mailbox;
@@ -25,6 +26,7 @@ use footbot_foraging::FootbotForaging;
 use footbot_gripping::FootbotGripping;
 use footbot_synchronization::FootbotSynchronization;
 use mail_probe::MailProbe;
+use navigation_coordinator::NavigationCoordinator;
 use sensor_probe::SensorProbe;
 
 /// A controller that maps each tick's frame straight to a command (ARGoS' `ControlStep`).
@@ -77,6 +79,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (MailProbe::NAME, |p| {
         Ok(Box::new(MailProbe::from_params(p)?))
+    }),
+    (NavigationCoordinator::NAME, |p| {
+        Ok(Box::new(NavigationCoordinator::from_params(p)?))
     }),
     (SensorProbe::NAME, |p| {
         Ok(Box::new(SensorProbe::from_params(p)?))

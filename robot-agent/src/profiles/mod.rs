@@ -4,6 +4,7 @@
 
 pub mod aggregation;
 pub mod foraging;
+pub mod navigation;
 pub mod obstacle_avoidance;
 pub mod pheromone_foraging;
 pub mod phototaxis;
@@ -22,6 +23,7 @@ use crate::profile::Profile;
 
 use aggregation::Aggregation;
 use foraging::Forager;
+use navigation::Navigator;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
 use pheromone_foraging::PheromoneForager;
 use phototaxis::Phototaxis;
@@ -79,6 +81,7 @@ const PROFILES: &[(&str, BindFn)] = &[
     (Forager::NAME, bind_boxed::<Forager>),
     (PheromoneForager::NAME, bind_boxed::<PheromoneForager>),
     (Phototaxis::NAME, bind_boxed::<Phototaxis>),
+    (Navigator::NAME, bind_boxed::<Navigator>),
 ];
 
 /// Why a profile could not be set up.
@@ -166,7 +169,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation)"
         );
     }
 

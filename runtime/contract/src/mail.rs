@@ -25,6 +25,9 @@ pub const MAIL_PAYLOAD_BYTES: usize = 256;
 pub const MAILBOX_CAPACITY: usize = 32;
 /// The `to` of a message for every participant (alone: all; with a range: those within it).
 pub const TO_ALL: u32 = u32::MAX;
+/// The `from` of a message the world itself sends: its loop functions acting as a task server (the navigation
+/// task's goals and map, docs/messages.md). No participant has this index.
+pub const FROM_WORLD: u32 = u32::MAX;
 /// The `len` of a closed mailbox ([`Mailbox::closed`]).
 const CLOSED: u32 = u32::MAX;
 

@@ -6,6 +6,7 @@ pub mod aggregation;
 pub mod argos_foraging;
 pub mod default;
 pub mod foraging;
+pub mod navigation;
 pub mod obstacle_avoidance;
 pub mod params;
 pub mod pheromone_foraging;
@@ -14,6 +15,7 @@ pub mod synchronisation;
 
 use std::collections::BTreeMap;
 
+use swarm_contract::mail::Mail;
 use swarm_contract::messages::ActuatorCommand;
 
 use crate::arena::Arena;
@@ -22,6 +24,17 @@ use crate::geometry::Vec2;
 
 /// The experiment hooks of one task.
 pub trait LoopFunctions: Send {
+    /// Called once when the world is built, after every entity is in the arena: may move robots to the poses
+    /// the task wants them at (with [`Arena::place_robot`]; ARGoS loop functions' `Init`).
+    fn place(&mut self, _arena: &mut Arena) -> Result<(), WorldError> {
+        Ok(())
+    }
+
+    /// Called after every tick in a run with a messages medium: appends to `letters` what the world sends the
+    /// participants this tick (each to one participant, from [`swarm_contract::mail::FROM_WORLD`]; delivered
+    /// in the next tick like the participants' messages).
+    fn post_mail(&mut self, _arena: &Arena, _letters: &mut Vec<Mail>) {}
+
     /// Called at the start of every tick's act phase, before the actuators are applied.
     fn pre_step(&mut self, _arena: &mut Arena) {}
 
@@ -125,7 +138,7 @@ pub struct LoopFunctionsRegistry {
 impl Default for LoopFunctionsRegistry {
     /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
     /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`,
-    /// `phototaxis_loop_functions`.
+    /// `phototaxis_loop_functions`, `navigation_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -145,6 +158,7 @@ impl Default for LoopFunctionsRegistry {
             pheromone_foraging::PheromoneForaging::factory,
         );
         registry.register(phototaxis::LABEL, phototaxis::Phototaxis::factory);
+        registry.register(navigation::LABEL, navigation::Navigation::factory);
         registry
     }
 }

@@ -86,6 +86,59 @@ impl<'a> ParamReader<'a> {
         }
     }
 
+    /// Attribute `name`, which must be one of `choices`, or `default` when absent.
+    pub fn choice(
+        &self,
+        name: &str,
+        choices: &[&'static str],
+        default: &'static str,
+    ) -> Result<&'static str, WorldError> {
+        let Some(raw) = self.raw(name) else {
+            return Ok(default);
+        };
+        choices
+            .iter()
+            .find(|c| **c == raw.trim())
+            .copied()
+            .ok_or_else(|| self.invalid(name, raw, &format!("one of {}", choices.join(", "))))
+    }
+
+    /// Attribute `name` as a list of points `x,y; x,y; ...` (finite numbers), or `None` when absent.
+    pub fn points(&self, name: &str) -> Result<Option<Vec<(f64, f64)>>, WorldError> {
+        let Some(raw) = self.raw(name) else {
+            return Ok(None);
+        };
+        raw.split(';')
+            .map(|point| {
+                let mut xy = point.split(',').map(|v| v.trim().parse::<f64>());
+                match (xy.next(), xy.next(), xy.next()) {
+                    (Some(Ok(x)), Some(Ok(y)), None) if x.is_finite() && y.is_finite() => {
+                        Ok((x, y))
+                    }
+                    _ => Err(self.invalid(name, raw, "points `x,y` separated by `;`")),
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map(Some)
+    }
+
+    /// Attribute `name` as one point `x,y`, or `default` when absent.
+    pub fn point(&self, name: &str, default: (f64, f64)) -> Result<(f64, f64), WorldError> {
+        match self.points(name)?.as_deref() {
+            None => Ok(default),
+            Some([point]) => Ok(*point),
+            Some(_) => Err(self.invalid(name, self.raw(name).map_or("", |r| r), "one point `x,y`")),
+        }
+    }
+
+    /// An error about this element as a whole (`message` says what is wrong).
+    pub fn error(&self, message: String) -> WorldError {
+        WorldError::Invalid {
+            location: self.params.location.clone(),
+            message: format!("<{}>: {message}", self.element),
+        }
+    }
+
     /// The text of attribute `name` of this element, if given.
     fn raw(&self, name: &str) -> Option<&String> {
         self.params

@@ -14,7 +14,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use swarm_contract::config::MessagesMedium;
-use swarm_contract::mail::{Address, MAILBOX_CAPACITY, Mail, Mailbox};
+use swarm_contract::mail::{Address, FROM_WORLD, MAILBOX_CAPACITY, Mail, Mailbox};
 
 use crate::geometry::Vec2;
 use crate::rng::{self, Purpose};
@@ -255,6 +255,37 @@ impl MailMedium {
                     }
                 }
             }
+        }
+    }
+
+    /// Delivers the world's own `letters` (sent by the loop functions in `tick`, each addressed to one
+    /// participant): they are neither lost nor out of range, but a participant that is down or has a full inbox
+    /// does not get them, and every decision is recorded like a participant's message.
+    pub fn post_letters(
+        &mut self,
+        tick: u64,
+        letters: &[Mail],
+        participants: &[Participant],
+        inboxes: &mut [Mailbox],
+        records: &mut Vec<MessageRecord>,
+    ) {
+        for mail in letters {
+            let Address::To(to) = mail.address() else {
+                continue;
+            };
+            let fate = if to as usize >= participants.len() {
+                Fate::UnknownRecipient
+            } else {
+                self.deliver(mail, None, to, participants, inboxes)
+            };
+            records.push(MessageRecord {
+                tick,
+                from: FROM_WORLD,
+                to: Some(to),
+                address: mail.address(),
+                bytes: mail.len,
+                fate,
+            });
         }
     }
 

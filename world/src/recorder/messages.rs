@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use swarm_contract::mail::Address;
+use swarm_contract::mail::{Address, FROM_WORLD};
 use swarm_contract::run_dir::MESSAGES_FILE;
 
 use super::csv_line::CsvFile;
@@ -37,7 +37,12 @@ impl MessagesWriter {
     }
 
     fn format(&mut self, row: &MessageRecord) -> std::io::Result<()> {
-        let line = self.file.line().int(row.tick)?.int(row.from)?;
+        let line = self.file.line().int(row.tick)?;
+        let line = if row.from == FROM_WORLD {
+            line.text("world")?
+        } else {
+            line.int(row.from)?
+        };
         let line = match row.to {
             Some(to) => line.int(to)?,
             None => line.text("")?,

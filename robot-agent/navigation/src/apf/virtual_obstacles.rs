@@ -50,7 +50,10 @@ pub fn gap_plugs(
         for b in &obstacles[i + 1..] {
             out.extend(plug(&a, &field(b), params.plug_radius, params.influence));
         }
-        for n in neighbours.iter().filter(|n| n.status == Status::Stopped) {
+        for n in neighbours
+            .iter()
+            .filter(|n| n.status == Status::Stopped && n.id != me.id)
+        {
             let stopped = params.field(me.radius, n.position, n.radius);
             out.extend(plug(&a, &stopped, params.plug_radius, params.influence));
         }
