@@ -370,7 +370,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` in <params> (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation)"
         );
     }
 
@@ -384,7 +384,7 @@ mod tests {
              footbot_diffusion_controller, footbot_flocking_controller, footbot_foraging_controller, \
              footbot_gripping_controller, footbot_synchronization_controller, epuck_obstacleavoidance, \
              footbot_diffusion, footbot_flocking, footbot_foraging, footbot_gripping, footbot_synchronization, \
-             disc_wander, mail_probe, sensor_probe"
+             disc_wander, mail_probe, navigation_coordinator, sensor_probe"
         );
     }
 }

@@ -366,7 +366,7 @@ mod tests {
             position: V2::new(id as f32, -1.5),
             heading: 0.25,
             radius: 0.105,
-            status: if id % 2 == 0 {
+            status: if id.is_multiple_of(2) {
                 Status::Moving
             } else {
                 Status::Stopped

@@ -284,14 +284,14 @@ impl Profile for Navigator {
                 Ok(Letter::Map(chunk)) if mail.from == FROM_WORLD => {
                     self.map.add(&chunk, chunk.discs());
                 }
-                Ok(Letter::Snapshot(chunk)) if mail.from != FROM_WORLD => {
-                    if self.snapshot.add(&chunk, chunk.neighbours()) {
-                        self.heard = Some(inbox.tick);
-                        self.coordinator = Some(mail.from);
-                        let me = inbox.owner;
-                        if let Some(mine) = self.snapshot.items.iter().find(|n| n.id == me) {
-                            self.priority = mine.priority;
-                        }
+                Ok(Letter::Snapshot(chunk))
+                    if mail.from != FROM_WORLD && self.snapshot.add(&chunk, chunk.neighbours()) =>
+                {
+                    self.heard = Some(inbox.tick);
+                    self.coordinator = Some(mail.from);
+                    let me = inbox.owner;
+                    if let Some(mine) = self.snapshot.items.iter().find(|n| n.id == me) {
+                        self.priority = mine.priority;
                     }
                 }
                 // Anything else (a report meant for a coordinator, a forged letter, garbage) is not for a robot.

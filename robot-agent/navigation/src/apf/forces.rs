@@ -4,7 +4,7 @@
 
 use std::f32::consts::FRAC_PI_2;
 
-use super::{Field, TurnRule};
+use super::{Field, Params, TurnRule};
 use crate::V2;
 use crate::vec2::{sign, wrap};
 
@@ -83,17 +83,17 @@ fn adaptive(base: V2, psi: f32, turn: f32) -> V2 {
 
 /// Eq. 4: an obstacle's (or stopped robot's, or virtual obstacle's) force on a robot at `position` heading
 /// `heading` towards `goal`: base repulsion plus, when `adaptive` is on, the adaptive force.
+/// `params` gives `F_A`, the threshold angle and the distance clamp.
 pub fn obstacle_force(
-    f_a: f32,
+    params: &Params,
     field: &Field,
     position: V2,
     heading: f32,
     goal: V2,
-    threshold: f32,
     adaptive_on: bool,
-    min_distance: f32,
 ) -> V2 {
-    let base = base_repulsion(f_a, field, position, min_distance);
+    let base = base_repulsion(params.attraction, field, position, params.min_distance);
+    let threshold = params.threshold_angle;
     if !adaptive_on || base == V2::ZERO {
         return base;
     }
@@ -251,33 +251,21 @@ mod tests {
 
     #[test]
     fn heading_at_an_obstacle_the_robot_is_sent_round_its_goal_side() {
-        let threshold = 30f32.to_radians();
         // Robot at (-0.8, 0) heading +x straight at the obstacle, goal ahead and a little to the left (+y).
         let position = V2::new(-0.8, 0.0);
         let left_goal = V2::new(3.0, 0.5);
-        let f = obstacle_force(
-            1.0,
-            &field(),
-            position,
-            0.0,
-            left_goal,
-            threshold,
-            true,
-            0.01,
-        );
+        let f = obstacle_force(&Params::default(), &field(), position, 0.0, left_goal, true);
         // psi = 0 -> sign +1; phi > 0 -> T = +1; the base force points -x (angle pi) and the adaptive one at
         // pi - 90 deg = +y: the sum is base magnitude * (-1, 1).
         assert!(close(f, V2::new(-0.102_968, 0.102_968)), "{f:?}");
         let right_goal = V2::new(3.0, -0.5);
         let f = obstacle_force(
-            1.0,
+            &Params::default(),
             &field(),
             position,
             0.0,
             right_goal,
-            threshold,
             true,
-            0.01,
         );
         assert!(close(f, V2::new(-0.102_968, -0.102_968)), "{f:?}");
         // Total = radial rotated by 45 degrees and scaled by sqrt 2.
@@ -292,26 +280,22 @@ mod tests {
         let heading = 60f32.to_radians();
         assert_eq!(obstacle_turn(heading, -0.3, threshold), 1.0);
         let f = obstacle_force(
-            1.0,
+            &Params::default(),
             &field(),
             position,
             heading,
             V2::new(3.0, -0.5),
-            threshold,
             true,
-            0.01,
         );
         assert!(f.y > 0.0, "{f:?}");
         // Switched off, only the radial force is left.
         let f = obstacle_force(
-            1.0,
+            &Params::default(),
             &field(),
             position,
             heading,
             V2::new(3.0, -0.5),
-            threshold,
             false,
-            0.01,
         );
         assert!(close(f, V2::new(-0.102_968, 0.0)));
     }

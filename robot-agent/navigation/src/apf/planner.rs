@@ -77,16 +77,7 @@ pub fn total_force(
         Method::AmrApf => {
             let parts = params.parts;
             let obstacle = |field: &super::Field, adaptive: bool| {
-                obstacle_force(
-                    f_a,
-                    field,
-                    me.position,
-                    me.heading,
-                    me.goal,
-                    params.threshold_angle,
-                    adaptive,
-                    d_min,
-                )
+                obstacle_force(params, field, me.position, me.heading, me.goal, adaptive)
             };
             let mut force = attraction(f_a, me.position, me.goal);
             for o in obstacles {
