@@ -168,7 +168,7 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
         assert!(!outcome.output.status.success(), "{edit} was accepted");
         let stderr = outcome.stderr();
         assert!(
-            stderr.contains(&format!("{config}:35:")),
+            stderr.contains(&format!("{config}:{}:", loop_functions_line(&config))),
             "{edit}: no location in\n{stderr}"
         );
         assert!(
@@ -186,4 +186,13 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
             .stderr()
             .contains("<navigation layout=\"spiral\">: must be one of circle, random, as_placed")
     );
+}
+
+/// The line of the `<loop_functions>` element of the configuration at `path`, where task errors point.
+fn loop_functions_line(path: &str) -> usize {
+    let text = std::fs::read_to_string(path).expect("the configuration");
+    1 + text
+        .lines()
+        .position(|l| l.contains("<loop_functions"))
+        .expect("a <loop_functions> element")
 }
