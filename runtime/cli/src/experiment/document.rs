@@ -200,23 +200,27 @@ impl Document {
 
     /// The text with `edits` applied (later edits of the same attribute win).
     pub fn apply(&self, edits: &[Edit]) -> String {
-        // (offset, replaced range end, new text), applied from the end so earlier offsets stay valid.
-        let mut splices: Vec<(usize, usize, String)> = Vec::new();
+        // (offset, replaced range end, attribute, new text), applied from the end so earlier offsets stay valid.
+        // New attributes of one element all go in at the same offset, so an edit replaces an earlier one only
+        // when it is about the same attribute of the same element.
+        let mut splices: Vec<(usize, usize, &str, String)> = Vec::new();
         for edit in edits {
             let escaped = quick_xml::escape::escape(edit.value.as_str()).into_owned();
-            let splice = match self.attribute(edit.node, &edit.attribute) {
+            let (start, end, new) = match self.attribute(edit.node, &edit.attribute) {
                 Some(range) => (range.start, range.end, escaped),
                 None => {
                     let at = self.nodes[edit.node].name_end;
                     (at, at, format!(" {}=\"{escaped}\"", edit.attribute))
                 }
             };
-            splices.retain(|(start, end, _)| !(*start == splice.0 && *end == splice.1));
-            splices.push(splice);
+            splices.retain(|(s, e, attribute, _)| {
+                !(*s == start && *e == end && *attribute == edit.attribute)
+            });
+            splices.push((start, end, &edit.attribute, new));
         }
-        splices.sort_by_key(|(start, _, _)| std::cmp::Reverse(*start));
+        splices.sort_by_key(|(start, _, _, _)| std::cmp::Reverse(*start));
         let mut text = self.text.clone();
-        for (start, end, new) in splices {
+        for (start, end, _, new) in splices {
             text.replace_range(start..end, &new);
         }
         text
@@ -440,6 +444,20 @@ mod tests {
             derived.contains(r#"<epuck_proximity noise_level="0.05" implementation="default"/>"#)
         );
         assert!(derived.contains(r#"<epuck_light noise_level="0.05"/>"#));
+    }
+
+    #[test]
+    fn several_missing_attributes_of_one_element_are_all_inserted() {
+        let document = Document::parse(TEXT).expect("parses");
+        let mut edits = Vec::new();
+        for (attribute, value) in [("k1", "1"), ("k2", "2"), ("k1", "3")] {
+            let address = Address::parse(&format!("arena@{attribute}")).expect("an address");
+            edits.extend(document.edits(&address, value).expect("edits"));
+        }
+        let derived = document.apply(&edits);
+        let arena = derived.lines().find(|l| l.contains("<arena")).expect("the arena");
+        assert!(arena.contains(r#"k1="3""#) && arena.contains(r#"k2="2""#), "{arena}");
+        assert!(!arena.contains(r#"k1="1""#), "{arena}");
     }
 
     #[test]
