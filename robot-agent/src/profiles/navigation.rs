@@ -127,8 +127,8 @@ fn positive(params: &Params, name: &str, default: f32) -> Result<f32, ParamError
     }
 }
 
-/// The planner parameters of a controller's `<params>` (shared with the coordinator's priority choice).
-pub fn apf_params(params: &Params) -> Result<ApfParams, ParamError> {
+/// The planner parameters of a controller's `<params>`.
+fn apf_params(params: &Params) -> Result<ApfParams, ParamError> {
     let d = ApfParams::default();
     Ok(ApfParams {
         method: match choice(params, "method", &["amr_apf", "dapf", "apf"], "amr_apf")? {

@@ -44,6 +44,9 @@ use crate::rng::{Purpose, stream};
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "navigation_loop_functions";
+// The navigation letters must fit the messages medium.
+const _: () = assert!(PAYLOAD <= swarm_contract::mail::MAIL_PAYLOAD_BYTES);
+
 /// The file, in the run folder, with one row per goal reached.
 pub const OUTPUT: &str = "navigation.csv";
 const ATTEMPTS: usize = 10_000;
@@ -65,7 +68,7 @@ enum Goals {
 /// One robot's current task and what it did so far.
 #[derive(Debug, Clone, Default)]
 struct Trip {
-    /// Task number (1, 2, ... ; 0 before the first).
+    /// Task number (1, 2, ...).
     seq: u32,
     goal: V2,
     started: u64,
@@ -96,6 +99,8 @@ pub struct Navigation {
     rng: ChaCha8Rng,
     trips: Vec<Trip>,
     map: Vec<Disc>,
+    /// The map's chunks as sent with every task.
+    map_letters: Vec<Vec<u8>>,
     arrivals: u64,
     last_arrival_tick: u64,
     flowtime_ticks: u64,
@@ -168,6 +173,7 @@ impl Navigation {
             rng: stream(params.seed, Purpose::LoopFunctions, 0),
             trips: Vec::new(),
             map: Vec::new(),
+            map_letters: Vec::new(),
             arrivals: 0,
             last_arrival_tick: 0,
             flowtime_ticks: 0,
@@ -205,14 +211,10 @@ impl Navigation {
         None
     }
 
-    fn radius_of(arena: &Arena, robot: usize) -> f32 {
-        arena.robots[robot].body.radius
-    }
-
     fn starts(&mut self, arena: &mut Arena) -> Result<(), WorldError> {
         let n = arena.robots.len();
         for i in 0..n {
-            let radius = Self::radius_of(arena, i);
+            let radius = arena.robots[i].body.radius;
             let (position, heading) = match self.layout {
                 Layout::AsPlaced => continue,
                 Layout::Circle => {
@@ -296,6 +298,7 @@ impl Navigation {
         self.trips = goals
             .into_iter()
             .map(|goal| Trip {
+                seq: 1,
                 goal,
                 ..Trip::default()
             })
@@ -335,6 +338,21 @@ impl Navigation {
             )));
         }
         Ok(())
+    }
+
+    /// The map as the payloads of its chunks (the map never changes, so they are encoded once).
+    fn map_payloads(&self) -> Vec<Vec<u8>> {
+        let mut payload = [0u8; PAYLOAD];
+        let mut chunks = Vec::new();
+        let mut first = 0;
+        loop {
+            let (len, next) = wire::encode_map(&self.map, first, &mut payload);
+            chunks.push(payload[..len].to_vec());
+            if next >= self.map.len() {
+                return chunks;
+            }
+            first = next;
+        }
     }
 
     fn error(&self, message: String) -> WorldError {
@@ -412,9 +430,7 @@ impl LoopFunctions for Navigation {
         }
         self.starts(arena)?;
         self.first_goals(arena)?;
-        for trip in &mut self.trips {
-            trip.seq = 1;
-        }
+        self.map_letters = self.map_payloads();
         Ok(())
     }
 
@@ -467,8 +483,7 @@ impl LoopFunctions for Navigation {
         let mut payload = [0u8; PAYLOAD];
         for (i, trip) in self.trips.iter_mut().enumerate() {
             let r = &arena.robots[i];
-            if !(r.present && r.alive) || trip.done && !self.continuous && trip.last_sent.is_some()
-            {
+            if !(r.present && r.alive) || trip.done && trip.last_sent.is_some() {
                 continue;
             }
             if trip
@@ -492,14 +507,8 @@ impl LoopFunctions for Navigation {
             };
             let len = wire::encode_task(&task, &mut payload);
             send(&payload[..len]);
-            let mut first = 0;
-            loop {
-                let (len, next) = wire::encode_map(&self.map, first, &mut payload);
-                send(&payload[..len]);
-                if next >= self.map.len() {
-                    break;
-                }
-                first = next;
+            for chunk in &self.map_letters {
+                send(chunk);
             }
         }
     }

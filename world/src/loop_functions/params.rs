@@ -131,14 +131,6 @@ impl<'a> ParamReader<'a> {
         }
     }
 
-    /// An error about this element as a whole (`message` says what is wrong).
-    pub fn error(&self, message: String) -> WorldError {
-        WorldError::Invalid {
-            location: self.params.location.clone(),
-            message: format!("<{}>: {message}", self.element),
-        }
-    }
-
     /// The text of attribute `name` of this element, if given.
     fn raw(&self, name: &str) -> Option<&String> {
         self.params

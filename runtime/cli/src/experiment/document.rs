@@ -455,8 +455,14 @@ mod tests {
             edits.extend(document.edits(&address, value).expect("edits"));
         }
         let derived = document.apply(&edits);
-        let arena = derived.lines().find(|l| l.contains("<arena")).expect("the arena");
-        assert!(arena.contains(r#"k1="3""#) && arena.contains(r#"k2="2""#), "{arena}");
+        let arena = derived
+            .lines()
+            .find(|l| l.contains("<arena"))
+            .expect("the arena");
+        assert!(
+            arena.contains(r#"k1="3""#) && arena.contains(r#"k2="2""#),
+            "{arena}"
+        );
         assert!(!arena.contains(r#"k1="1""#), "{arena}");
     }
 
