@@ -1,0 +1,225 @@
+//! What a path planner plans in: the box the robot must stay in and disc obstacles, grown by the robot's
+//! radius so that the robot can be planned for as a point (its configuration space).
+
+use crate::V2;
+use crate::apf::Disc;
+
+/// An axis-aligned rectangle: the box constraint of a planner (paper D's `[X_min, X_max] x [Y_min, Y_max]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Lower-left corner.
+    pub min: V2,
+    /// Upper-right corner.
+    pub max: V2,
+}
+
+impl Bounds {
+    /// Whether `p` lies in the box (edges included).
+    pub fn contains(&self, p: V2) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+
+    /// `p` with each coordinate clamped into the box (paper D, step 7).
+    pub fn clamp(&self, p: V2) -> V2 {
+        V2::new(
+            p.x.clamp(self.min.x, self.max.x),
+            p.y.clamp(self.min.y, self.max.y),
+        )
+    }
+
+    /// Length of the box's diagonal.
+    pub fn diagonal(&self) -> f32 {
+        (self.max - self.min).length()
+    }
+
+    /// Whether both corners are finite and `min` is below and left of `max`.
+    pub fn is_valid(&self) -> bool {
+        self.min.is_finite()
+            && self.max.is_finite()
+            && self.min.x < self.max.x
+            && self.min.y < self.max.y
+    }
+}
+
+/// Disc obstacles inside a box, as a point robot sees them: every disc already grown by the robot's radius and
+/// safety margin ([`Map::grown`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Map {
+    /// Where the robot may be.
+    pub bounds: Bounds,
+    /// The obstacles.
+    pub discs: Vec<Disc>,
+}
+
+/// Distance from `c` to the segment `a`-`b`.
+pub fn segment_distance(a: V2, b: V2, c: V2) -> f32 {
+    let ab = b - a;
+    let len2 = ab.dot(ab);
+    let t = if len2 > 0.0 {
+        ((c - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * t - c).length()
+}
+
+/// Whether the segment `a`-`b` passes through the inside of `disc` (touching its edge is allowed).
+pub fn segment_hits(a: V2, b: V2, disc: &Disc) -> bool {
+    let r = disc.radius;
+    let c = disc.centre;
+    // The bounding boxes first: most discs of a map are far from any one segment.
+    if c.x + r < a.x.min(b.x)
+        || c.x - r > a.x.max(b.x)
+        || c.y + r < a.y.min(b.y)
+        || c.y - r > a.y.max(b.y)
+    {
+        return false;
+    }
+    segment_distance(a, b, c) < r
+}
+
+impl Map {
+    /// The same map with every disc's radius grown by `by` metres.
+    pub fn grown(&self, by: f32) -> Map {
+        Map {
+            bounds: self.bounds,
+            discs: self
+                .discs
+                .iter()
+                .map(|d| Disc {
+                    centre: d.centre,
+                    radius: d.radius + by,
+                })
+                .collect(),
+        }
+    }
+
+    /// Whether the point `p` lies strictly inside an obstacle.
+    pub fn inside_obstacle(&self, p: V2) -> bool {
+        self.discs
+            .iter()
+            .any(|d| (p - d.centre).length() < d.radius)
+    }
+
+    /// Whether `p` is in the box and outside every obstacle.
+    pub fn free(&self, p: V2) -> bool {
+        self.bounds.contains(p) && !self.inside_obstacle(p)
+    }
+
+    /// Whether the segment `a`-`b` stays in the box and clear of every obstacle.
+    pub fn segment_free(&self, a: V2, b: V2) -> bool {
+        self.bounds.contains(a)
+            && self.bounds.contains(b)
+            && !self.discs.iter().any(|d| segment_hits(a, b, d))
+    }
+
+    /// Index of the first segment of `path` (segment `i` joins points `i` and `i + 1`) that is not free, if any.
+    pub fn first_blocked_segment(&self, path: &[V2]) -> Option<usize> {
+        path.windows(2).position(|w| !self.segment_free(w[0], w[1]))
+    }
+}
+
+/// Length of a polyline.
+pub fn path_length(path: &[V2]) -> f32 {
+    path.windows(2).map(|w| (w[1] - w[0]).length()).sum()
+}
+
+/// `path` with every corner dropped whose neighbours see each other on `map` (greedy line-of-sight pruning from
+/// the start): never longer than `path`, free wherever `path` was.
+pub fn shortcut(path: &[V2], map: &Map) -> Vec<V2> {
+    let Some(&first) = path.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![first];
+    let mut anchor = 0;
+    while anchor + 1 < path.len() {
+        let mut reach = anchor + 1;
+        for candidate in (anchor + 2..path.len()).rev() {
+            if map.segment_free(path[anchor], path[candidate]) {
+                reach = candidate;
+                break;
+            }
+        }
+        out.push(path[reach]);
+        anchor = reach;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(side: f32) -> Bounds {
+        Bounds {
+            min: V2::ZERO,
+            max: V2::new(side, side),
+        }
+    }
+
+    fn one_disc() -> Map {
+        Map {
+            bounds: square(4.0),
+            discs: vec![Disc {
+                centre: V2::new(2.0, 2.0),
+                radius: 0.5,
+            }],
+        }
+    }
+
+    #[test]
+    fn a_segment_through_a_disc_is_blocked_and_one_past_it_is_free() {
+        let map = one_disc();
+        assert!(!map.segment_free(V2::new(0.5, 2.0), V2::new(3.5, 2.0)));
+        assert!(map.segment_free(V2::new(0.5, 2.6), V2::new(3.5, 2.6)));
+        // A segment ending before the disc is free even though its line would cross it.
+        assert!(map.segment_free(V2::new(0.5, 2.0), V2::new(1.4, 2.0)));
+        // Leaving the box is not free.
+        assert!(!map.segment_free(V2::new(0.5, 2.0), V2::new(4.5, 2.0)));
+    }
+
+    #[test]
+    fn segment_distance_of_a_hand_computed_case() {
+        assert!(
+            (segment_distance(V2::ZERO, V2::new(4.0, 0.0), V2::new(1.0, 3.0)) - 3.0).abs() < 1e-6
+        );
+        assert!(
+            (segment_distance(V2::ZERO, V2::new(4.0, 0.0), V2::new(7.0, 4.0)) - 5.0).abs() < 1e-6
+        );
+        assert!((segment_distance(V2::ZERO, V2::ZERO, V2::new(3.0, 4.0)) - 5.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn growing_a_map_grows_every_disc() {
+        let map = one_disc().grown(0.25);
+        assert_eq!(map.discs[0].radius, 0.75);
+        assert!(map.inside_obstacle(V2::new(2.7, 2.0)));
+        assert!(!one_disc().inside_obstacle(V2::new(2.7, 2.0)));
+    }
+
+    #[test]
+    fn shortcut_drops_corners_that_see_past_each_other_only() {
+        let map = one_disc();
+        let zigzag = [
+            V2::new(0.5, 0.5),
+            V2::new(1.0, 0.7),
+            V2::new(1.5, 0.5),
+            V2::new(3.5, 0.5),
+            V2::new(3.5, 3.5),
+        ];
+        let short = shortcut(&zigzag, &map);
+        assert_eq!(
+            short,
+            vec![V2::new(0.5, 0.5), V2::new(3.5, 0.5), V2::new(3.5, 3.5)]
+        );
+        assert!(path_length(&short) <= path_length(&zigzag));
+        assert_eq!(map.first_blocked_segment(&short), None);
+        // Around the disc no corner can go: the direct line crosses it.
+        let around = [V2::new(0.5, 2.0), V2::new(2.0, 3.0), V2::new(3.5, 2.0)];
+        assert_eq!(shortcut(&around, &map), around.to_vec());
+        assert_eq!(
+            map.first_blocked_segment(&[V2::new(0.5, 2.0), V2::new(3.5, 2.0)]),
+            Some(0)
+        );
+    }
+}
