@@ -292,6 +292,7 @@ impl WorldBuilder {
             participants: Vec::new(),
             coordinators: self.coordinators,
             letters: Vec::new(),
+            to_world: Vec::new(),
         };
         world.update_media();
         world
@@ -319,6 +320,8 @@ pub struct World {
     coordinators: Vec<Coordinator>,
     /// What the loop functions send this tick, refilled each tick.
     letters: Vec<Mail>,
+    /// What the participants sent the world this tick (for its loop functions).
+    to_world: Vec<Mail>,
 }
 
 impl World {
@@ -404,7 +407,15 @@ impl World {
                 None => Participant { up, position: None },
             },
         ));
-        mail.route(tick, outboxes, &self.participants, inboxes, records);
+        mail.route(
+            tick,
+            outboxes,
+            &self.participants,
+            inboxes,
+            &mut self.to_world,
+            records,
+        );
+        self.loop_functions.read_mail(&self.arena, &self.to_world);
         self.letters.clear();
         self.loop_functions
             .post_mail(&self.arena, &mut self.letters);

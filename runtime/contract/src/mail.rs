@@ -28,6 +28,9 @@ pub const TO_ALL: u32 = u32::MAX;
 /// The `from` of a message the world itself sends: its loop functions acting as a task server (the navigation
 /// task's goals and map, docs/messages.md). No participant has this index.
 pub const FROM_WORLD: u32 = u32::MAX;
+/// The address of the world itself (`Address::To(TO_WORLD)`): letters to its loop functions, such as a robot's
+/// planning statistics for the task's judge (docs/messages.md). No participant has this index.
+pub const TO_WORLD: u32 = u32::MAX - 1;
 /// The `len` of a closed mailbox ([`Mailbox::closed`]).
 const CLOSED: u32 = u32::MAX;
 

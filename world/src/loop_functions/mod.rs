@@ -35,6 +35,11 @@ pub trait LoopFunctions: Send {
     /// in the next tick like the participants' messages).
     fn post_mail(&mut self, _arena: &Arena, _letters: &mut Vec<Mail>) {}
 
+    /// Called after every tick in a run with a messages medium, before [`LoopFunctions::post_mail`], with what
+    /// the participants sent the world this tick (`Address::To(`[`swarm_contract::mail::TO_WORLD`]`)`); `from`
+    /// is the true sender. The letters come from robots' code: decode them as hostile input.
+    fn read_mail(&mut self, _arena: &Arena, _letters: &[Mail]) {}
+
     /// Called at the start of every tick's act phase, before the actuators are applied.
     fn pre_step(&mut self, _arena: &mut Arena) {}
 

@@ -14,7 +14,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use swarm_contract::config::MessagesMedium;
-use swarm_contract::mail::{Address, FROM_WORLD, MAILBOX_CAPACITY, Mail, Mailbox};
+use swarm_contract::mail::{Address, FROM_WORLD, MAILBOX_CAPACITY, Mail, Mailbox, TO_WORLD};
 
 use crate::geometry::Vec2;
 use crate::rng::{self, Purpose};
@@ -176,18 +176,21 @@ impl MailMedium {
 
     /// Decides the fate of every message of `outboxes` (one per sending participant, in participant order) sent
     /// in `tick`: each delivered message goes into its recipient's entry of `inboxes` (one per participant,
-    /// emptied first), and every decision into `records` (appended to).
+    /// emptied first) or, addressed to [`TO_WORLD`], into `to_world` (emptied first; never lost, the world is no
+    /// radio), and every decision into `records` (appended to).
     pub fn route(
         &mut self,
         tick: u64,
         outboxes: &[Mailbox],
         participants: &[Participant],
         inboxes: &mut [Mailbox],
+        to_world: &mut Vec<Mail>,
         records: &mut Vec<MessageRecord>,
     ) {
         for inbox in inboxes.iter_mut() {
             inbox.clear();
         }
+        to_world.clear();
         for outbox in outboxes {
             let from = outbox.owner;
             for (index, mail) in outbox.messages().iter().enumerate() {
@@ -218,6 +221,10 @@ impl MailMedium {
                 }
                 let sender = participants.get(from as usize).and_then(|p| p.position);
                 match mail.address() {
+                    Address::To(TO_WORLD) => {
+                        to_world.push(*mail);
+                        records.push(record(Some(TO_WORLD), Fate::Delivered));
+                    }
                     Address::To(to) if to == from || to as usize >= participants.len() => {
                         records.push(record(Some(to), Fate::UnknownRecipient));
                     }
@@ -365,7 +372,14 @@ mod tests {
         let mut inboxes: Vec<Mailbox> =
             (0..participants.len() as u32).map(Mailbox::empty).collect();
         let mut records = Vec::new();
-        medium.route(5, outboxes, participants, &mut inboxes, &mut records);
+        medium.route(
+            5,
+            outboxes,
+            participants,
+            &mut inboxes,
+            &mut Vec::new(),
+            &mut records,
+        );
         let fates = records.iter().map(|r| (r.to, r.fate)).collect();
         (inboxes, fates)
     }
@@ -470,6 +484,44 @@ mod tests {
     }
 
     #[test]
+    fn letters_to_the_world_reach_it_whatever_the_loss_and_range() {
+        let mut medium = medium(Some(0.1), 1.0);
+        let participants = [robot(0.0), robot(5.0)];
+        let sent = [
+            outbox(0, &[(Address::To(TO_WORLD), b"stats")]),
+            outbox(1, &[(Address::To(0), b"lost")]),
+        ];
+        let mut inboxes: Vec<Mailbox> = (0..2).map(Mailbox::empty).collect();
+        let (mut to_world, mut records) = (Vec::new(), Vec::new());
+        medium.route(
+            1,
+            &sent,
+            &participants,
+            &mut inboxes,
+            &mut to_world,
+            &mut records,
+        );
+        assert_eq!(to_world.len(), 1);
+        assert_eq!(
+            (to_world[0].from, to_world[0].payload()),
+            (0, &b"stats"[..])
+        );
+        assert_eq!(records[0].to, Some(TO_WORLD));
+        assert_eq!(records[0].fate, Fate::Delivered);
+        assert_ne!(records[1].fate, Fate::Delivered);
+        // The next tick starts with nothing for the world.
+        medium.route(
+            2,
+            &[],
+            &participants,
+            &mut inboxes,
+            &mut to_world,
+            &mut records,
+        );
+        assert!(to_world.is_empty());
+    }
+
+    #[test]
     fn the_tally_counts_each_fate_under_its_reason() {
         assert!(
             Fate::ALL
@@ -482,7 +534,14 @@ mod tests {
         let sent = [outbox(0, &[(Address::All, b"hi")])];
         let mut inboxes: Vec<Mailbox> = (0..3).map(Mailbox::empty).collect();
         let mut records = Vec::new();
-        medium.route(1, &sent, &participants, &mut inboxes, &mut records);
+        medium.route(
+            1,
+            &sent,
+            &participants,
+            &mut inboxes,
+            &mut Vec::new(),
+            &mut records,
+        );
         let mut tally = MessageTally::default();
         tally.add(&records);
         assert_eq!(

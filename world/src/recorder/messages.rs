@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use swarm_contract::mail::{Address, FROM_WORLD};
+use swarm_contract::mail::{Address, FROM_WORLD, TO_WORLD};
 use swarm_contract::run_dir::MESSAGES_FILE;
 
 use super::csv_line::CsvFile;
@@ -44,6 +44,7 @@ impl MessagesWriter {
             line.int(row.from)?
         };
         let line = match row.to {
+            Some(TO_WORLD) => line.text("world")?,
             Some(to) => line.int(to)?,
             None => line.text("")?,
         };
