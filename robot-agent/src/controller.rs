@@ -370,7 +370,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` in <params> (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning)"
         );
     }
 

@@ -157,6 +157,49 @@ impl Params {
         }
     }
 
+    /// `name` as a finite `f32` > 0, or `default` when absent.
+    pub fn positive_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+        let v = self.f32_or(name, default)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(ParamError::OutOfRange {
+                name: name.to_owned(),
+                value: self.get(name).unwrap_or_default().to_owned(),
+                rule: "must be > 0",
+            })
+        }
+    }
+
+    /// `name`, which must be one of `choices`, or `default` when absent.
+    pub fn choice_or<'a>(
+        &self,
+        name: &str,
+        choices: &[&'a str],
+        default: &'a str,
+    ) -> Result<&'a str, ParamError> {
+        match self.get(name).map(str::trim) {
+            None => Ok(default),
+            Some(raw) => {
+                choices
+                    .iter()
+                    .find(|c| **c == raw)
+                    .copied()
+                    .ok_or_else(|| ParamError::Malformed {
+                        name: name.into(),
+                        value: raw.into(),
+                        expected: "one of the documented choices",
+                    })
+            }
+        }
+    }
+
+    /// `name` as `true` or `false`, or `default` when absent.
+    pub fn flag_or(&self, name: &str, default: bool) -> Result<bool, ParamError> {
+        let default = if default { "true" } else { "false" };
+        Ok(self.choice_or(name, &["true", "false"], default)? == "true")
+    }
+
     /// `name` as a finite `f32` in `[0, 1]` (a sensor reading), or `default` when absent.
     pub fn unit_f32_or(&self, name: &str, default: f32) -> Result<f32, ParamError> {
         let v = self.f32_or(name, default)?;

@@ -8,12 +8,15 @@
 //! | 2 | [`Chunk`] of [`Disc`]s: the obstacle map | task server -> robot |
 //! | 3 | [`Report`]: pose, status, goal | robot -> coordinator |
 //! | 4 | [`Chunk`] of [`Neighbour`]s: the snapshot with priorities | coordinator -> every participant |
+//! | 5 | [`Bounds`]: the box a path planner keeps to | task server -> robot |
+//! | 6 | [`PlanReport`]: a path planner's statistics for its current task | robot -> task server |
 //!
 //! A map or snapshot longer than one payload is sent as several chunks in the same tick; each says how many
 //! entries the whole has and where it starts.
 
 use crate::V2;
 use crate::apf::{Disc, Neighbour, Status};
+use crate::planning::Bounds;
 
 /// Largest payload (the messages medium's).
 pub const PAYLOAD: usize = 256;
@@ -21,6 +24,10 @@ const TASK: u8 = 1;
 const MAP: u8 = 2;
 const REPORT: u8 = 3;
 const SNAPSHOT: u8 = 4;
+const BOUNDS: u8 = 5;
+const PLAN_REPORT: u8 = 6;
+const BOUNDS_LEN: usize = 1 + 4 * 4;
+const PLAN_REPORT_LEN: usize = 1 + 6 * 4 + 2 * 4;
 const TASK_LEN: usize = 1 + 4 + 4 * 4;
 const REPORT_LEN: usize = 1 + 4 * 4 + 1 + 2 * 4;
 const CHUNK_HEADER: usize = 1 + 2 + 2 + 1;
@@ -84,6 +91,27 @@ pub struct Report {
     pub goal: V2,
 }
 
+/// What a path-planning robot did for one task so far (counts from the task's start).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PlanReport {
+    /// The task's number.
+    pub seq: u32,
+    /// Planner runs.
+    pub plans: u32,
+    /// Planner runs that found no path.
+    pub failed: u32,
+    /// Replans because the path was found blocked by an obstacle the map did not have.
+    pub replans: u32,
+    /// Sum over the runs of the agents whose trajectories were collision-free (|S_cf|).
+    pub collision_free: u32,
+    /// Sum over the runs of the agents (N).
+    pub agents: u32,
+    /// Length of the first plan's path as the planner chose it (m; 0 before the first plan).
+    pub first_planned: f32,
+    /// Length of the first plan's path as the robot follows it, after smoothing (m).
+    pub first_followed: f32,
+}
+
 /// Part of a map or snapshot: `count` entries from `first` of a whole of `total`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chunk<'a> {
@@ -105,6 +133,10 @@ pub enum Letter<'a> {
     Report(Report),
     /// Part of the coordinator's snapshot.
     Snapshot(Chunk<'a>),
+    /// The planning box.
+    Bounds(Bounds),
+    /// A path planner's statistics.
+    PlanReport(PlanReport),
 }
 
 struct Writer<'a> {
@@ -185,6 +217,32 @@ pub fn encode_report(report: &Report, out: &mut [u8; PAYLOAD]) -> usize {
     w.f32(report.heading).f32(report.radius);
     w.bytes(&[u8::from(report.status == Status::Moving)]);
     w.f32(report.goal.x).f32(report.goal.y);
+    w.at
+}
+
+/// Writes `bounds` into `out`; returns the payload length.
+pub fn encode_bounds(bounds: &Bounds, out: &mut [u8; PAYLOAD]) -> usize {
+    let mut w = Writer { out, at: 0 };
+    w.bytes(&[BOUNDS]).f32(bounds.min.x).f32(bounds.min.y);
+    w.f32(bounds.max.x).f32(bounds.max.y);
+    w.at
+}
+
+/// Writes `report` into `out`; returns the payload length.
+pub fn encode_plan_report(report: &PlanReport, out: &mut [u8; PAYLOAD]) -> usize {
+    let mut w = Writer { out, at: 0 };
+    w.bytes(&[PLAN_REPORT]);
+    for n in [
+        report.seq,
+        report.plans,
+        report.failed,
+        report.replans,
+        report.collision_free,
+        report.agents,
+    ] {
+        w.bytes(&n.to_le_bytes());
+    }
+    w.f32(report.first_planned).f32(report.first_followed);
     w.at
 }
 
@@ -306,6 +364,40 @@ pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
                 goal: r.v2()?,
             }))
         }
+        BOUNDS => {
+            let mut r = exact(BOUNDS_LEN)?;
+            let bounds = Bounds {
+                min: r.v2()?,
+                max: r.v2()?,
+            };
+            if bounds.is_valid() {
+                Ok(Letter::Bounds(bounds))
+            } else {
+                Err(WireError::BadNumber)
+            }
+        }
+        PLAN_REPORT => {
+            let mut r = exact(PLAN_REPORT_LEN)?;
+            let report = PlanReport {
+                seq: r.u32(),
+                plans: r.u32(),
+                failed: r.u32(),
+                replans: r.u32(),
+                collision_free: r.u32(),
+                agents: r.u32(),
+                first_planned: r.f32()?,
+                first_followed: r.f32()?,
+            };
+            let consistent = report.failed <= report.plans
+                && report.collision_free <= report.agents
+                && report.first_planned >= 0.0
+                && report.first_followed >= 0.0;
+            if consistent {
+                Ok(Letter::PlanReport(report))
+            } else {
+                Err(WireError::BadNumber)
+            }
+        }
         MAP => Ok(Letter::Map(chunk(payload, MAP, DISC_LEN)?)),
         SNAPSHOT => Ok(Letter::Snapshot(chunk(payload, SNAPSHOT, NEIGHBOUR_LEN)?)),
         other => Err(WireError::UnknownTag(other)),
@@ -395,6 +487,42 @@ mod tests {
         };
         let len = encode_report(&report, &mut out);
         assert_eq!(decode(&out[..len]), Ok(Letter::Report(report)));
+        let bounds = Bounds {
+            min: V2::new(-1.0, 0.0),
+            max: V2::new(9.0, 10.0),
+        };
+        let len = encode_bounds(&bounds, &mut out);
+        assert_eq!(decode(&out[..len]), Ok(Letter::Bounds(bounds)));
+        let stats = PlanReport {
+            seq: 2,
+            plans: 3,
+            failed: 1,
+            replans: 1,
+            collision_free: 40,
+            agents: 150,
+            first_planned: 12.5,
+            first_followed: 9.25,
+        };
+        let len = encode_plan_report(&stats, &mut out);
+        assert_eq!(decode(&out[..len]), Ok(Letter::PlanReport(stats)));
+    }
+
+    #[test]
+    fn inconsistent_bounds_and_reports_are_errors() {
+        let mut out = [0u8; PAYLOAD];
+        let inverted = Bounds {
+            min: V2::new(1.0, 0.0),
+            max: V2::new(0.0, 1.0),
+        };
+        let len = encode_bounds(&inverted, &mut out);
+        assert_eq!(decode(&out[..len]), Err(WireError::BadNumber));
+        let more_failures_than_runs = PlanReport {
+            plans: 1,
+            failed: 2,
+            ..PlanReport::default()
+        };
+        let len = encode_plan_report(&more_failures_than_runs, &mut out);
+        assert_eq!(decode(&out[..len]), Err(WireError::BadNumber));
     }
 
     #[test]
@@ -466,7 +594,7 @@ mod tests {
         }
 
         #[test]
-        fn tagged_garbage_never_panics(tag in 1u8..5, bytes in prop::collection::vec(any::<u8>(), 0..260)) {
+        fn tagged_garbage_never_panics(tag in 1u8..7, bytes in prop::collection::vec(any::<u8>(), 0..260)) {
             let mut payload = vec![tag];
             payload.extend(bytes);
             if let Ok(Letter::Snapshot(c) | Letter::Map(c)) = decode(&payload) {

@@ -3,9 +3,11 @@
 //! [`bind_profile`] builds one robot's memory from its parameters and binds it to a supervisor set's events.
 
 pub mod aggregation;
+mod assembly;
 pub mod foraging;
 pub mod navigation;
 pub mod obstacle_avoidance;
+pub mod path_planning;
 pub mod pheromone_foraging;
 pub mod phototaxis;
 pub mod synchronisation;
@@ -25,6 +27,7 @@ use aggregation::Aggregation;
 use foraging::Forager;
 use navigation::Navigator;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
+use path_planning::PathPlanner;
 use pheromone_foraging::PheromoneForager;
 use phototaxis::Phototaxis;
 use synchronisation::{Synchronisation, SynchronisationSct};
@@ -82,6 +85,7 @@ const PROFILES: &[(&str, BindFn)] = &[
     (PheromoneForager::NAME, bind_boxed::<PheromoneForager>),
     (Phototaxis::NAME, bind_boxed::<Phototaxis>),
     (Navigator::NAME, bind_boxed::<Navigator>),
+    (PathPlanner::NAME, bind_boxed::<PathPlanner>),
 ];
 
 /// Why a profile could not be set up.
@@ -169,7 +173,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning)"
         );
     }
 

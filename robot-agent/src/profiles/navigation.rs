@@ -28,44 +28,15 @@ use swarm_navigation::apf::planner::{Scratch, plan};
 use swarm_navigation::apf::{
     Disc, Me, Method, Neighbour, Params as ApfParams, Parts, PlugRadius, Status, TurnRule,
 };
-use swarm_navigation::wire::{self, Chunk, Letter, PAYLOAD, Report, Task};
+use swarm_navigation::wire::{self, Letter, PAYLOAD, Report, Task};
 
+use super::assembly::Assembly;
 use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
 
 /// Default number of ticks without a snapshot after which the coordinator counts as lost.
 pub const DEFAULT_STALE_TICKS: u64 = 10;
 const DEFAULT_CAPACITY: usize = 1024;
-
-/// A whole (map or snapshot) assembled from chunks within one inbox.
-#[derive(Debug)]
-struct Assembly<T> {
-    items: Vec<T>,
-    expected: usize,
-}
-
-impl<T> Assembly<T> {
-    fn with_capacity(capacity: usize) -> Self {
-        Assembly {
-            items: Vec::with_capacity(capacity),
-            expected: usize::MAX,
-        }
-    }
-
-    /// Takes in one chunk; returns whether the whole is complete.
-    fn add(&mut self, chunk: &Chunk<'_>, entries: impl Iterator<Item = T>) -> bool {
-        if chunk.first == 0 {
-            self.items.clear();
-            self.expected = usize::from(chunk.total);
-        } else if usize::from(chunk.first) != self.items.len() {
-            self.expected = usize::MAX;
-            return false;
-        }
-        let room = self.items.capacity() - self.items.len();
-        self.items.extend(entries.take(room));
-        self.items.len() >= self.expected.min(self.items.capacity())
-    }
-}
 
 /// Profile `navigation`: one robot's planner, its view of the others, its map and its task.
 #[derive(Debug)]
@@ -88,63 +59,24 @@ pub struct Navigator {
     scratch: Scratch,
 }
 
-fn choice<'a>(
-    params: &Params,
-    name: &str,
-    choices: &[&'a str],
-    default: &'a str,
-) -> Result<&'a str, ParamError> {
-    match params.get(name).map(str::trim) {
-        None => Ok(default),
-        Some(raw) => {
-            choices
-                .iter()
-                .find(|c| **c == raw)
-                .copied()
-                .ok_or_else(|| ParamError::Malformed {
-                    name: name.into(),
-                    value: raw.into(),
-                    expected: "one of the documented choices (docs/navigation.md)",
-                })
-        }
-    }
-}
-
-fn flag(params: &Params, name: &str) -> Result<bool, ParamError> {
-    Ok(choice(params, name, &["true", "false"], "true")? == "true")
-}
-
-fn positive(params: &Params, name: &str, default: f32) -> Result<f32, ParamError> {
-    let value = params.non_negative_f32_or(name, default)?;
-    if value > 0.0 {
-        Ok(value)
-    } else {
-        Err(ParamError::OutOfRange {
-            name: name.into(),
-            value: value.to_string(),
-            rule: "must be > 0",
-        })
-    }
-}
-
 /// The planner parameters of a controller's `<params>`.
 fn apf_params(params: &Params) -> Result<ApfParams, ParamError> {
     let d = ApfParams::default();
     Ok(ApfParams {
-        method: match choice(params, "method", &["amr_apf", "dapf", "apf"], "amr_apf")? {
+        method: match params.choice_or("method", &["amr_apf", "dapf", "apf"], "amr_apf")? {
             "amr_apf" => Method::AmrApf,
             "dapf" => Method::Dapf,
             _ => Method::Apf,
         },
         parts: Parts {
-            adaptive_obstacles: flag(params, "adaptive_obstacles")?,
-            adaptive_robots: flag(params, "adaptive_robots")?,
-            gap_plugs: flag(params, "gap_plugs")?,
-            clusters: flag(params, "clusters")?,
+            adaptive_obstacles: params.flag_or("adaptive_obstacles", true)?,
+            adaptive_robots: params.flag_or("adaptive_robots", true)?,
+            gap_plugs: params.flag_or("gap_plugs", true)?,
+            clusters: params.flag_or("clusters", true)?,
         },
-        attraction: positive(params, "attraction", d.attraction)?,
+        attraction: params.positive_f32_or("attraction", d.attraction)?,
         caution: params.non_negative_f32_or("caution", d.caution)?,
-        influence: positive(params, "influence", d.influence)?,
+        influence: params.positive_f32_or("influence", d.influence)?,
         threshold_angle: params
             .non_negative_f32_or("threshold_angle", d.threshold_angle.to_degrees())?
             .to_radians(),
@@ -154,13 +86,12 @@ fn apf_params(params: &Params) -> Result<ApfParams, ParamError> {
         k_w: params.non_negative_f32_or("k_w", d.k_w)?,
         max_speed: params.non_negative_f32_or("max_speed", d.max_speed)?,
         max_turn_rate: params.non_negative_f32_or("max_turn_rate", d.max_turn_rate)?,
-        min_distance: positive(params, "min_distance", d.min_distance)?,
-        turn_rule: match choice(params, "turn_rule", &["described", "literal"], "described")? {
+        min_distance: params.positive_f32_or("min_distance", d.min_distance)?,
+        turn_rule: match params.choice_or("turn_rule", &["described", "literal"], "described")? {
             "described" => TurnRule::Described,
             _ => TurnRule::Literal,
         },
-        plug_radius: match choice(
-            params,
+        plug_radius: match params.choice_or(
             "plug_radius",
             &["enclosing", "published"],
             "enclosing",

@@ -20,8 +20,12 @@
 //! - `goal_tolerance` (0.1 m), `tasks` (`single`: the run ends when every robot has arrived once;
 //!   `continuous`: a new random goal on every arrival), `repeat` (seconds between re-sending a robot its task
 //!   and map, default 1), `stall_speed` (m/s under which a robot on its way counts as stopped, default 0.01).
+//! - `hidden`: cylinders left out of the map the robots get (ids separated by spaces or commas; `h*` for every
+//!   id starting with `h`): obstacles a path-planning robot only finds with its range finder (docs/planning.md).
 //!
-//! The map is the arena's cylinders; walls and boxes are not part of the method's map.
+//! The map is the arena's cylinders; walls and boxes are not part of the method's map. With the map the robots
+//! get the arena's rectangle (a planner's box). A robot that plans paths reports its planner's statistics to the
+//! world (`wire::PlanReport`); each trip is also measured against the reference optimum of `planning`.
 
 use std::fmt::Write as _;
 
@@ -32,7 +36,8 @@ use swarm_contract::mail::{Address, Mail};
 use swarm_contract::messages::ActuatorCommand;
 use swarm_navigation::V2;
 use swarm_navigation::apf::Disc;
-use swarm_navigation::wire::{self, PAYLOAD, Task};
+use swarm_navigation::planning::Bounds;
+use swarm_navigation::wire::{self, Letter, PAYLOAD, PlanReport, Task};
 
 use crate::arena::Arena;
 use crate::entities::RobotId;
@@ -41,6 +46,9 @@ use crate::geometry::{Shape, Vec2};
 use crate::loop_functions::params::ParamReader;
 use crate::loop_functions::{LoopFunctions, LoopFunctionsParams};
 use crate::rng::{Purpose, stream};
+
+mod planning;
+use planning::{Totals, TripFigures, optimum};
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "navigation_loop_functions";
@@ -71,6 +79,8 @@ struct Trip {
     /// Task number (1, 2, ...).
     seq: u32,
     goal: V2,
+    /// Where the robot was when the task started.
+    start: V2,
     started: u64,
     path: f64,
     last: Option<V2>,
@@ -80,6 +90,8 @@ struct Trip {
     seen: bool,
     stalled: bool,
     last_sent: Option<u64>,
+    /// The robot's last planner statistics for this task.
+    report: Option<PlanReport>,
 }
 
 /// The navigation task server and judge.
@@ -98,8 +110,15 @@ pub struct Navigation {
     stall_speed: f32,
     rng: ChaCha8Rng,
     trips: Vec<Trip>,
+    /// Every cylinder of the arena.
     map: Vec<Disc>,
-    /// The map's chunks as sent with every task.
+    /// The cylinders the robots are told about (all but the hidden ones).
+    known: Vec<Disc>,
+    /// Ids (or `prefix*` patterns) of hidden cylinders.
+    hidden: Vec<String>,
+    bounds: Bounds,
+    totals: Totals,
+    /// The known map's chunks and the bounds, as sent with every task.
     map_letters: Vec<Vec<u8>>,
     arrivals: u64,
     last_arrival_tick: u64,
@@ -140,6 +159,7 @@ impl Navigation {
                 "tasks",
                 "repeat",
                 "stall_speed",
+                "hidden",
             ],
         )?;
         let layout = match r.choice("layout", &["circle", "random", "as_placed"], "circle")? {
@@ -173,6 +193,13 @@ impl Navigation {
             rng: stream(params.seed, Purpose::LoopFunctions, 0),
             trips: Vec::new(),
             map: Vec::new(),
+            known: Vec::new(),
+            hidden: r.words("hidden"),
+            bounds: Bounds {
+                min: V2::ZERO,
+                max: V2::ZERO,
+            },
+            totals: Totals::default(),
             map_letters: Vec::new(),
             arrivals: 0,
             last_arrival_tick: 0,
@@ -185,7 +212,10 @@ impl Navigation {
             ticks_per_second: 1,
             repeat_seconds: r.positive("repeat", 1.0)?,
             location: params.location.clone(),
-            output: String::from("tick,robot,task,goal_x,goal_y,duration_s,path_m\n"),
+            output: String::from(
+                "tick,robot,task,goal_x,goal_y,duration_s,path_m,optimum_m,plans,failed_plans,replans,\
+                 collision_free_fraction,planned_m,followed_m\n",
+            ),
         }))
     }
 
@@ -340,19 +370,30 @@ impl Navigation {
         Ok(())
     }
 
-    /// The map as the payloads of its chunks (the map never changes, so they are encoded once).
+    /// The known map as the payloads of its chunks, then the bounds (they never change, so they are encoded
+    /// once).
     fn map_payloads(&self) -> Vec<Vec<u8>> {
         let mut payload = [0u8; PAYLOAD];
         let mut chunks = Vec::new();
         let mut first = 0;
         loop {
-            let (len, next) = wire::encode_map(&self.map, first, &mut payload);
+            let (len, next) = wire::encode_map(&self.known, first, &mut payload);
             chunks.push(payload[..len].to_vec());
-            if next >= self.map.len() {
-                return chunks;
+            if next >= self.known.len() {
+                break;
             }
             first = next;
         }
+        let len = wire::encode_bounds(&self.bounds, &mut payload);
+        chunks.push(payload[..len].to_vec());
+        chunks
+    }
+
+    fn is_hidden(&self, name: &str) -> bool {
+        self.hidden.iter().any(|h| match h.strip_suffix('*') {
+            Some(prefix) => name.starts_with(prefix),
+            None => h == name,
+        })
     }
 
     fn error(&self, message: String) -> WorldError {
@@ -362,23 +403,51 @@ impl Navigation {
         }
     }
 
-    fn arrive(&mut self, arena: &Arena, robot: usize) {
+    fn arrive(&mut self, arena: &Arena, robot: usize, here: V2) {
         let tps = f64::from(self.ticks_per_second);
+        let radius = arena.robots[robot].body.radius;
+        let trip = &self.trips[robot];
+        let figures = TripFigures {
+            optimum: optimum(trip.start, trip.goal, &self.map, self.bounds, radius),
+            known_optimum: trip.report.and(optimum(
+                trip.start,
+                trip.goal,
+                &self.known,
+                self.bounds,
+                radius,
+            )),
+            driven: trip.path,
+            report: trip.report,
+        };
+        self.totals.add(&figures);
         let trip = &mut self.trips[robot];
         self.arrivals += 1;
         self.last_arrival_tick = self.tick;
         self.flowtime_ticks += self.tick - trip.started;
         self.completed_path += trip.path;
+        let cell = |x: Option<String>| x.unwrap_or_default();
+        let report = trip.report;
         let _ = writeln!(
             self.output,
-            "{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             self.tick,
             robot,
             trip.seq,
             trip.goal.x,
             trip.goal.y,
             (self.tick - trip.started) as f64 / tps,
-            trip.path
+            trip.path,
+            cell(figures.optimum.map(|o| o.to_string())),
+            cell(report.map(|r| r.plans.to_string())),
+            cell(report.map(|r| r.failed.to_string())),
+            cell(report.map(|r| r.replans.to_string())),
+            cell(
+                report
+                    .filter(|r| r.agents > 0)
+                    .map(|r| (f64::from(r.collision_free) / f64::from(r.agents)).to_string())
+            ),
+            cell(report.map(|r| r.first_planned.to_string())),
+            cell(report.map(|r| r.first_followed.to_string())),
         );
         if !self.continuous {
             trip.done = true;
@@ -390,6 +459,8 @@ impl Navigation {
         match next {
             Some(goal) => {
                 trip.goal = goal;
+                trip.start = here;
+                trip.report = None;
                 trip.seq += 1;
                 trip.started = self.tick;
                 trip.path = 0.0;
@@ -428,6 +499,33 @@ impl LoopFunctions for Navigation {
         if self.map.len() > usize::from(u16::MAX) {
             return Err(self.error("the map holds at most 65,535 cylinders".into()));
         }
+        let cylinders: Vec<&str> = arena
+            .obstacles
+            .iter()
+            .filter(|o| matches!(o.placed.shape, Shape::Disc { .. }))
+            .map(|o| o.name.as_str())
+            .collect();
+        if let Some(unknown) = self.hidden.iter().find(|h| {
+            let prefix = h.strip_suffix('*');
+            !cylinders
+                .iter()
+                .any(|c| prefix.map_or(*c == h.as_str(), |p| c.starts_with(p)))
+        }) {
+            return Err(self.error(format!(
+                "`hidden` names `{unknown}`, which matches no cylinder of the arena"
+            )));
+        }
+        self.known = self
+            .map
+            .iter()
+            .zip(&cylinders)
+            .filter(|(_, name)| !self.is_hidden(name))
+            .map(|(disc, _)| *disc)
+            .collect();
+        self.bounds = Bounds {
+            min: to_v2(arena.min),
+            max: to_v2(arena.max),
+        };
         self.starts(arena)?;
         self.first_goals(arena)?;
         self.map_letters = self.map_payloads();
@@ -449,6 +547,7 @@ impl LoopFunctions for Navigation {
             if !trip.seen {
                 trip.seen = true;
                 trip.started = self.tick;
+                trip.start = here;
             }
             let step = trip.last.map_or(0.0, |last| (here - last).length());
             trip.last = Some(here);
@@ -462,7 +561,7 @@ impl LoopFunctions for Navigation {
             }
             trip.stalled = stalled;
             if (trip.goal - here).length() < self.tolerance {
-                self.arrive(arena, i);
+                self.arrive(arena, i, here);
             }
         }
         let robots = &arena.robots;
@@ -513,6 +612,18 @@ impl LoopFunctions for Navigation {
         }
     }
 
+    fn read_mail(&mut self, _arena: &Arena, letters: &[Mail]) {
+        for mail in letters {
+            if let Ok(Letter::PlanReport(report)) = wire::decode(mail.payload())
+                && let Some(trip) = self.trips.get_mut(mail.from as usize)
+                && trip.seq == report.seq
+                && !trip.done
+            {
+                trip.report = Some(report);
+            }
+        }
+    }
+
     fn is_finished(&self, _arena: &Arena) -> bool {
         !self.continuous && !self.trips.is_empty() && self.trips.iter().all(|t| t.done)
     }
@@ -522,7 +633,7 @@ impl LoopFunctions for Navigation {
         let robots = self.trips.len();
         let arrived = self.trips.iter().filter(|t| t.done).count();
         let finite = |x: f32| x.is_finite().then_some(f64::from(x));
-        json!({
+        let mut metrics = json!({
             "robots": robots,
             "tasks_completed": self.arrivals,
             "failures": if self.continuous { 0 } else { robots - arrived },
@@ -534,7 +645,11 @@ impl LoopFunctions for Navigation {
             "min_clearance_m": finite(self.min_clearance),
             "collisions": arena.robots.iter().map(|r| r.collisions).sum::<u64>(),
             "stop_events": self.stop_events,
-        })
+        });
+        if let Some(object) = metrics.as_object_mut() {
+            self.totals.metrics(object);
+        }
+        metrics
     }
 
     fn output_name(&self) -> Option<&str> {

@@ -131,6 +131,16 @@ impl<'a> ParamReader<'a> {
         }
     }
 
+    /// Attribute `name` as a list of words separated by spaces or commas (empty when absent).
+    pub fn words(&self, name: &str) -> Vec<String> {
+        self.raw(name).map_or_else(Vec::new, |raw| {
+            raw.split([',', ' ', '\t', '\n'])
+                .filter(|w| !w.is_empty())
+                .map(String::from)
+                .collect()
+        })
+    }
+
     /// The text of attribute `name` of this element, if given.
     fn raw(&self, name: &str) -> Option<&String> {
         self.params

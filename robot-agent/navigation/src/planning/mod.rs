@@ -1,6 +1,7 @@
 //! Single-robot path planning among disc obstacles (paper D, docs/planning.md): the map a planner works in, the
 //! GSA planner, the any-angle grid search that serves as the reference optimum, a path follower, and reproducible test maps.
 
+pub mod discovery;
 pub mod follow;
 pub mod gsa;
 pub mod map;

@@ -8,6 +8,7 @@ use std::collections::BinaryHeap;
 
 use super::map::{Map, path_length};
 use crate::V2;
+use crate::apf::Disc;
 
 /// Most grid cells a search may use (about 40 MB of search state).
 pub const MAX_CELLS: usize = 4_000_000;
@@ -77,13 +78,31 @@ impl Grid<'_> {
 }
 
 /// The shortest any-angle path from `start` to `goal` on `map` that Theta* finds on a grid of `resolution`
-/// metres, from `start` to `goal` exactly.
+/// metres, from `start` to `goal` exactly. An obstacle that holds the start (a robot inside its safety margin)
+/// is shrunk to leave the start on its edge, so that the robot can leave it.
 pub fn shortest_path(
     start: V2,
     goal: V2,
     map: &Map,
     resolution: f32,
 ) -> Result<Vec<V2>, SearchError> {
+    let shrunk;
+    let map = if map.inside_obstacle(start) {
+        shrunk = Map {
+            bounds: map.bounds,
+            discs: map
+                .discs
+                .iter()
+                .map(|d| Disc {
+                    centre: d.centre,
+                    radius: d.radius.min((start - d.centre).length()),
+                })
+                .collect(),
+        };
+        &shrunk
+    } else {
+        map
+    };
     if !(start.is_finite() && map.bounds.contains(start)) {
         return Err(SearchError::OutOfBounds("start"));
     }
@@ -180,7 +199,6 @@ mod tests {
     use std::f32::consts::PI;
 
     use super::*;
-    use crate::apf::Disc;
     use crate::planning::map::Bounds;
 
     fn map(discs: &[(f32, f32, f32)]) -> Map {
@@ -213,6 +231,15 @@ mod tests {
         assert_eq!(m.first_blocked_segment(&path), None);
         assert_eq!(path.first(), Some(&V2::new(-2.0, 0.0)));
         assert_eq!(path.last(), Some(&V2::new(2.0, 0.0)));
+    }
+
+    #[test]
+    fn a_start_inside_an_obstacle_leaves_it() {
+        let m = map(&[(0.0, 0.0, 1.0)]);
+        let path = shortest_path(V2::new(-0.9, 0.0), V2::new(-3.0, 0.0), &m, 0.1).unwrap();
+        assert_eq!(path.len(), 2);
+        let across = shortest_path(V2::new(-0.9, 0.0), V2::new(3.0, 0.0), &m, 0.1).unwrap();
+        assert!(path_length(&across) > 4.0);
     }
 
     #[test]
