@@ -20,10 +20,10 @@
 //!
 //! Parameters: `planner` (`gsa` or `theta_star`), `shortcut` (true/false: follow the plan with its corners cut
 //! where the line of sight allows, default true), `margin` (m kept from obstacles beyond the body, default
-//! 0.05), the GSA's `agents`, `iterations`, `g0`, `alpha_g`, `kbest_final`, `initial_speed`, `max_step`,
+//! 0.1), the GSA's `agents`, `iterations`, `g0`, `alpha_g`, `kbest_final`, `initial_speed`, `max_step`,
 //! `goal_anchor` (true/false), `arrive_fraction`, `penalty` (0 for 10 times the box's diagonal), the reference
 //! planner's `resolution` (m, default 0.05), the follower's `lookahead`, `max_speed`, `max_turn_rate`, `k_w`,
-//! `k_v`, and the sensing's `tolerance`, `linkage` and `max_hits` (defaults: docs/planning.md).
+//! `k_v`, and the sensing's `tolerance`, `linkage`, `max_hits` and `max_fit_radius` (defaults: docs/planning.md).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -43,6 +43,9 @@ use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
 
 const DEFAULT_MAX_OBSTACLES: usize = 1024;
+/// Room kept between the body and an obstacle (m): the follower cuts a path's corners by a few centimetres, and
+/// the physics counts a contact a little before the bodies touch.
+const DEFAULT_MARGIN: f32 = 0.1;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Planner {
@@ -148,21 +151,29 @@ impl PathPlanner {
     }
 
     /// Whether the rest of the path, from the robot on, crosses a found obstacle (grown like the planner's).
-    /// An obstacle the robot already stands in does not block the first leg: the plan leads out of it.
-    fn rest_blocked(&self, here: V2, radius: f32) -> bool {
+    /// An obstacle the robot already stands in may be left, as the planner allows ([`Map::opened_at`]).
+    fn rest_blocked(&self, here: V2, radius: f32, bounds: Bounds) -> bool {
+        let found = Map {
+            bounds,
+            discs: self
+                .found
+                .obstacles()
+                .iter()
+                .map(|d| Disc {
+                    centre: d.centre,
+                    radius: d.radius + radius + self.margin,
+                })
+                .collect(),
+        };
         let rest = &self.path[self.progress.min(self.path.len())..];
-        let grow = radius + self.margin;
-        self.found.obstacles().iter().any(|d| {
-            let grown = Disc {
-                centre: d.centre,
-                radius: d.radius + grow,
-            };
-            let inside = (here - d.centre).length() < grown.radius;
-            let first = rest
-                .first()
-                .is_some_and(|&next| !inside && segment_hits(here, next, &grown));
-            first || rest.windows(2).any(|w| segment_hits(w[0], w[1], &grown))
-        })
+        let blocked = |a: V2, b: V2| found.discs.iter().any(|d| segment_hits(a, b, d));
+        rest.first().is_some_and(|&next| {
+            found
+                .opened_at(here)
+                .discs
+                .iter()
+                .any(|d| segment_hits(here, next, d))
+        }) || rest.windows(2).any(|w| blocked(w[0], w[1]))
     }
 
     /// One planner run; the result is in `path`/`outcome` and the task's statistics.
@@ -263,10 +274,10 @@ fn plan(s: &mut PathPlanner, frame: &SensorFrame, command: &mut ActuatorCommand)
 }
 
 fn follow(s: &mut PathPlanner, frame: &SensorFrame, command: &mut ActuatorCommand) {
-    let Some(task) = s.current else {
+    let (Some(task), Some(bounds)) = (s.current, s.bounds) else {
         return stand_still(command);
     };
-    if s.sense(frame) && s.rest_blocked(PathPlanner::position(frame), task.radius) {
+    if s.sense(frame) && s.rest_blocked(PathPlanner::position(frame), task.radius, bounds) {
         // Paper D: stop as soon as a new obstacle is seen on the way; `path_blocked` replans next tick.
         s.blocked = true;
         s.stats.replans += 1;
@@ -315,7 +326,7 @@ impl Profile for PathPlanner {
         Ok(PathPlanner {
             planner,
             cut_corners: params.flag_or("shortcut", true)?,
-            margin: params.non_negative_f32_or("margin", 0.05)?,
+            margin: params.non_negative_f32_or("margin", DEFAULT_MARGIN)?,
             pursuit: Pursuit {
                 lookahead: params.positive_f32_or("lookahead", p.lookahead)?,
                 max_speed: params.non_negative_f32_or("max_speed", p.max_speed)?,
@@ -328,6 +339,7 @@ impl Profile for PathPlanner {
                 spacing: d.spacing,
                 linkage: params.non_negative_f32_or("linkage", d.linkage)?,
                 capacity: params.whole_or("max_hits", d.capacity)?,
+                max_radius: params.positive_f32_or("max_fit_radius", d.max_radius)?,
             },
             run_seed: params.run_seed(),
             offered: None,

@@ -408,7 +408,9 @@ impl Navigation {
         let radius = arena.robots[robot].body.radius;
         let trip = &self.trips[robot];
         let figures = TripFigures {
-            optimum: optimum(trip.start, trip.goal, &self.map, self.bounds, radius),
+            // The trip ends on entering the goal's tolerance, so the reference ends there too.
+            optimum: optimum(trip.start, trip.goal, &self.map, self.bounds, radius)
+                .map(|o| (o - self.tolerance).max(0.0)),
             known_optimum: trip.report.and(optimum(
                 trip.start,
                 trip.goal,

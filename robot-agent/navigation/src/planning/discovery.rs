@@ -1,6 +1,8 @@
 //! Obstacles a robot finds with its range finder that its map does not have (paper D's hidden obstacles): every
-//! ray hit that no known obstacle and no edge of the box explains is remembered, hits close together form one
-//! obstacle, and each obstacle is the smallest disc holding its hits.
+//! ray hit that no known obstacle and no edge of the box explains is remembered, and hits close together form one
+//! obstacle. Obstacles are taken to be discs: three or more hits that lie on a circle (within the tolerance)
+//! give that circle, the whole cylinder including its unseen side; otherwise the obstacle is the smallest disc
+//! holding its hits, which grows as more of it comes into view.
 
 use super::map::Bounds;
 use crate::V2;
@@ -18,6 +20,9 @@ pub struct Sensing {
     pub linkage: f32,
     /// Most hits remembered; further ones are dropped (memory stays bounded).
     pub capacity: usize,
+    /// Largest radius a circle through the hits may have to be taken as the obstacle (m); hits along a wall or
+    /// a nearly straight arc fit huge circles, and fall back to the smallest disc holding them.
+    pub max_radius: f32,
 }
 
 impl Default for Sensing {
@@ -27,6 +32,7 @@ impl Default for Sensing {
             spacing: 0.03,
             linkage: 0.3,
             capacity: 4096,
+            max_radius: 1.5,
         }
     }
 }
@@ -95,12 +101,13 @@ impl Discoveries {
         if self.hits.len() == before {
             return false;
         }
-        self.regroup(sensing.linkage);
+        self.regroup(sensing);
         true
     }
 
-    /// Clusters the hits by single linkage and covers each cluster with its enclosing circle.
-    fn regroup(&mut self, linkage: f32) {
+    /// Clusters the hits by single linkage and makes each cluster an obstacle.
+    fn regroup(&mut self, sensing: &Sensing) {
+        let linkage = sensing.linkage;
         const UNLABELLED: usize = usize::MAX;
         self.cluster.clear();
         self.cluster.resize(self.hits.len(), UNLABELLED);
@@ -133,9 +140,59 @@ impl Discoveries {
                     .filter(|(_, k)| **k == c)
                     .map(|(h, _)| *h),
             );
-            self.obstacles.push(enclosing_circle(&self.members));
+            let enclosing = enclosing_circle(&self.members);
+            let obstacle = fit_circle(&self.members)
+                .filter(|fit| fit.radius <= sensing.max_radius)
+                .filter(|fit| {
+                    self.members.iter().all(|p| {
+                        ((*p - fit.centre).length() - fit.radius).abs() <= sensing.tolerance
+                    })
+                })
+                .unwrap_or(enclosing);
+            self.obstacles.push(obstacle);
         }
     }
+}
+
+/// The circle that best fits three or more points (Kasa's algebraic least squares: minimises
+/// `sum (x^2 + y^2 + D x + E y + F)^2`), or `None` for fewer points or points on a line.
+pub fn fit_circle(points: &[V2]) -> Option<Disc> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (mx, my) = points.iter().fold((0.0, 0.0), |(x, y), p| {
+        (x + f64::from(p.x) / n, y + f64::from(p.y) / n)
+    });
+    // Normal equations in coordinates centred on the mean (better conditioned).
+    let (mut sxx, mut sxy, mut syy, mut sxz, mut syz, mut sz) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for p in points {
+        let (x, y) = (f64::from(p.x) - mx, f64::from(p.y) - my);
+        let z = x * x + y * y;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
+        sxz += x * z;
+        syz += y * z;
+        sz += z;
+    }
+    // With centred coordinates sum x = sum y = 0, so D and E solve a 2 x 2 system and F = -mean z.
+    let det = sxx * syy - sxy * sxy;
+    if det.abs() < 1e-12 * (sxx + syy).powi(2).max(1e-30) {
+        return None;
+    }
+    let d = (-sxz * syy + syz * sxy) / det;
+    let e = (-syz * sxx + sxz * sxy) / det;
+    let f = -sz / n;
+    let (cx, cy) = (-d / 2.0, -e / 2.0);
+    let r2 = cx * cx + cy * cy - f;
+    if !(r2 > 0.0 && r2.is_finite()) {
+        return None;
+    }
+    Some(Disc {
+        centre: V2::new((cx + mx) as f32, (cy + my) as f32),
+        radius: r2.sqrt() as f32,
+    })
 }
 
 #[cfg(test)]
@@ -186,11 +243,26 @@ mod tests {
         assert!(hidden.sense(&sensing, at, 0.0, &readings, &[], &bounds()));
         let found = hidden.obstacles();
         assert_eq!(found.len(), 1);
-        // The seen side of the disc lies inside the found obstacle, which lies within the disc's reach.
-        assert!((found[0].centre - disc.centre).length() < disc.radius);
-        assert!(found[0].radius <= disc.radius + 1e-3);
+        // Three or more hits on its edge give the whole cylinder, its unseen side too.
+        assert!((found[0].centre - disc.centre).length() < 1e-3, "{found:?}");
+        assert!((found[0].radius - disc.radius).abs() < 1e-3, "{found:?}");
         // Reading the same again finds nothing new.
         assert!(!hidden.sense(&sensing, at, 0.0, &readings, &[], &bounds()));
+    }
+
+    #[test]
+    fn a_circle_is_fitted_to_points_on_it_and_not_to_a_line() {
+        let on_arc: Vec<V2> = [0.1f32, 0.4, 0.9]
+            .iter()
+            .map(|a| V2::new(2.0, -1.0) + V2::from_angle(*a) * 0.5)
+            .collect();
+        let fit = fit_circle(&on_arc).unwrap();
+        assert!(
+            (fit.centre - V2::new(2.0, -1.0)).length() < 1e-4 && (fit.radius - 0.5).abs() < 1e-4
+        );
+        let line = [V2::ZERO, V2::new(1.0, 1.0), V2::new(2.0, 2.0)];
+        assert_eq!(fit_circle(&line), None);
+        assert_eq!(fit_circle(&on_arc[..2]), None);
     }
 
     #[test]

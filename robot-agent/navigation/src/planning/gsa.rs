@@ -300,30 +300,13 @@ impl Swarm {
     }
 }
 
-/// Whether a trajectory touches no obstacle (step 9). Obstacles that contain the start (a robot inside its own
-/// safety margin) may be left but not re-entered: until the trajectory has left them they are ignored.
-fn collision_free(trajectory: &[V2], map: &Map, around_start: &[bool]) -> bool {
-    let mut leaving = around_start.iter().any(|&b| b);
-    for w in trajectory.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        for (disc, &holds_start) in map.discs.iter().zip(around_start) {
-            if (leaving && holds_start) || !segment_hits(a, b, disc) {
-                continue;
-            }
-            return false;
-        }
-        if leaving {
-            leaving = map
-                .discs
-                .iter()
-                .zip(around_start)
-                .any(|(d, &s)| s && (b - d.centre).length() < d.radius);
-        }
-    }
-    true
+/// Whether a trajectory touches no obstacle (step 9).
+fn collision_free(trajectory: &[V2], map: &Map) -> bool {
+    trajectory.windows(2).all(|w| map.segment_free(w[0], w[1]))
 }
 
-/// Plans a path from `start` to `goal` on `map` (obstacles already grown by the robot's size) with GSA. The
+/// Plans a path from `start` to `goal` on `map` (obstacles already grown by the robot's size) with GSA, on the
+/// map opened at the start ([`Map::opened_at`]: a robot inside an obstacle's safety margin may leave it). The
 /// result is a pure function of the inputs and `rng`'s state.
 pub fn plan(
     start: V2,
@@ -333,6 +316,7 @@ pub fn plan(
     rng: &mut impl Rng,
 ) -> Result<Plan, GsaError> {
     check(params)?;
+    let map = &*map.opened_at(start);
     if !(start.is_finite() && map.bounds.contains(start)) {
         return Err(GsaError::OutOfBounds("start"));
     }
@@ -356,15 +340,10 @@ pub fn plan(
         swarm.step(goal, map, g, k, params, rng);
         iterations += 1;
     }
-    let around_start: Vec<bool> = map
-        .discs
-        .iter()
-        .map(|d| (start - d.centre).length() < d.radius)
-        .collect();
     let mut free = 0;
     let mut best: Option<(f32, usize)> = None;
     for (i, trajectory) in swarm.trajectory.iter_mut().enumerate() {
-        if !collision_free(trajectory, map, &around_start) {
+        if !collision_free(trajectory, map) {
             continue;
         }
         free += 1;
@@ -548,14 +527,14 @@ mod tests {
     }
 
     #[test]
-    fn a_start_inside_the_safety_margin_may_leave_it_but_not_come_back() {
+    fn a_start_inside_the_safety_margin_may_leave_it_but_not_go_deeper() {
         let map = field(&[(5.0, 5.0, 1.0)]);
         let start = V2::new(5.0, 4.1); // 0.1 m inside the grown disc
         let (found, _) = plans(start, V2::new(5.0, 1.0), &map, &GsaParams::default(), 5);
         assert!(!found.is_empty());
-        let back_in = [start, V2::new(5.0, 3.0), V2::new(5.0, 4.05)];
-        assert!(!collision_free(&back_in, &map, &[true]));
-        assert!(collision_free(&back_in[..2], &map, &[true]));
+        let opened = map.opened_at(start);
+        assert!(collision_free(&[start, V2::new(5.0, 3.0)], &opened));
+        assert!(!collision_free(&[start, V2::new(5.0, 4.2)], &opened));
     }
 
     proptest::proptest! {

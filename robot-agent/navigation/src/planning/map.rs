@@ -1,6 +1,8 @@
 //! What a path planner plans in: the box the robot must stay in and disc obstacles, grown by the robot's
 //! radius so that the robot can be planned for as a point (its configuration space).
 
+use std::borrow::Cow;
+
 use crate::V2;
 use crate::apf::Disc;
 
@@ -113,6 +115,25 @@ impl Map {
             && !self.discs.iter().any(|d| segment_hits(a, b, d))
     }
 
+    /// The map as a robot at `start` may use it: an obstacle that holds `start` (a robot inside its safety
+    /// margin) is shrunk to leave `start` on its edge, so that the robot can move out but not further in.
+    pub fn opened_at(&self, start: V2) -> Cow<'_, Map> {
+        if !self.inside_obstacle(start) {
+            return Cow::Borrowed(self);
+        }
+        Cow::Owned(Map {
+            bounds: self.bounds,
+            discs: self
+                .discs
+                .iter()
+                .map(|d| Disc {
+                    centre: d.centre,
+                    radius: d.radius.min((start - d.centre).length()),
+                })
+                .collect(),
+        })
+    }
+
     /// Index of the first segment of `path` (segment `i` joins points `i` and `i + 1`) that is not free, if any.
     pub fn first_blocked_segment(&self, path: &[V2]) -> Option<usize> {
         path.windows(2).position(|w| !self.segment_free(w[0], w[1]))
@@ -195,6 +216,17 @@ mod tests {
         assert_eq!(map.discs[0].radius, 0.75);
         assert!(map.inside_obstacle(V2::new(2.7, 2.0)));
         assert!(!one_disc().inside_obstacle(V2::new(2.7, 2.0)));
+    }
+
+    #[test]
+    fn a_map_opened_at_a_point_inside_a_disc_lets_it_out_but_not_further_in() {
+        let map = one_disc();
+        let start = V2::new(2.0, 2.4);
+        let opened = map.opened_at(start);
+        assert!((opened.discs[0].radius - 0.4).abs() < 1e-6);
+        assert!(opened.segment_free(start, V2::new(2.0, 3.5)));
+        assert!(!opened.segment_free(start, V2::new(2.0, 2.3)));
+        assert!(matches!(map.opened_at(V2::new(0.5, 0.5)), Cow::Borrowed(_)));
     }
 
     #[test]

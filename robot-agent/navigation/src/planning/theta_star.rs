@@ -8,7 +8,6 @@ use std::collections::BinaryHeap;
 
 use super::map::{Map, path_length};
 use crate::V2;
-use crate::apf::Disc;
 
 /// Most grid cells a search may use (about 40 MB of search state).
 pub const MAX_CELLS: usize = 4_000_000;
@@ -78,31 +77,14 @@ impl Grid<'_> {
 }
 
 /// The shortest any-angle path from `start` to `goal` on `map` that Theta* finds on a grid of `resolution`
-/// metres, from `start` to `goal` exactly. An obstacle that holds the start (a robot inside its safety margin)
-/// is shrunk to leave the start on its edge, so that the robot can leave it.
+/// metres, from `start` to `goal` exactly, on the map opened at the start ([`Map::opened_at`]).
 pub fn shortest_path(
     start: V2,
     goal: V2,
     map: &Map,
     resolution: f32,
 ) -> Result<Vec<V2>, SearchError> {
-    let shrunk;
-    let map = if map.inside_obstacle(start) {
-        shrunk = Map {
-            bounds: map.bounds,
-            discs: map
-                .discs
-                .iter()
-                .map(|d| Disc {
-                    centre: d.centre,
-                    radius: d.radius.min((start - d.centre).length()),
-                })
-                .collect(),
-        };
-        &shrunk
-    } else {
-        map
-    };
+    let map = &*map.opened_at(start);
     if !(start.is_finite() && map.bounds.contains(start)) {
         return Err(SearchError::OutOfBounds("start"));
     }
@@ -199,6 +181,7 @@ mod tests {
     use std::f32::consts::PI;
 
     use super::*;
+    use crate::apf::Disc;
     use crate::planning::map::Bounds;
 
     fn map(discs: &[(f32, f32, f32)]) -> Map {

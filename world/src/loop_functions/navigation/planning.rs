@@ -36,7 +36,7 @@ pub fn optimum(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32)
 /// One finished trip's planning figures.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TripFigures {
-    /// Reference optimum on the whole map.
+    /// Reference optimum on the whole map, to the edge of the goal's tolerance.
     pub optimum: Option<f32>,
     /// Reference optimum on the map the robot was given.
     pub known_optimum: Option<f32>,
