@@ -111,23 +111,17 @@ impl PathPlanner {
     /// The map a point robot plans in: the known and found obstacles grown by the body and the margin, the box
     /// shrunk by the body.
     fn planning_map(&self, bounds: Bounds, radius: f32) -> Map {
-        let inset = V2::new(radius, radius);
         Map {
-            bounds: Bounds {
-                min: bounds.min + inset,
-                max: bounds.max - inset,
-            },
+            bounds: bounds.inset(radius),
             discs: self
                 .known
                 .items
                 .iter()
                 .chain(self.found.obstacles())
-                .map(|d| Disc {
-                    centre: d.centre,
-                    radius: d.radius + radius + self.margin,
-                })
+                .copied()
                 .collect(),
         }
+        .grown(radius + self.margin)
     }
 
     /// Reads the range finder; returns whether an obstacle was found or grew.
@@ -155,16 +149,9 @@ impl PathPlanner {
     fn rest_blocked(&self, here: V2, radius: f32, bounds: Bounds) -> bool {
         let found = Map {
             bounds,
-            discs: self
-                .found
-                .obstacles()
-                .iter()
-                .map(|d| Disc {
-                    centre: d.centre,
-                    radius: d.radius + radius + self.margin,
-                })
-                .collect(),
-        };
+            discs: self.found.obstacles().to_vec(),
+        }
+        .grown(radius + self.margin);
         let rest = &self.path[self.progress.min(self.path.len())..];
         let blocked = |a: V2, b: V2| found.discs.iter().any(|d| segment_hits(a, b, d));
         rest.first().is_some_and(|&next| {

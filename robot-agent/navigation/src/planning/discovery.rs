@@ -76,10 +76,7 @@ impl Discoveries {
     ) -> bool {
         let step = std::f32::consts::TAU / ranges.len().max(1) as f32;
         let tol = sensing.tolerance;
-        let inner = Bounds {
-            min: bounds.min + V2::new(tol, tol),
-            max: bounds.max - V2::new(tol, tol),
-        };
+        let inner = bounds.inset(tol);
         let before = self.hits.len();
         for (k, &range) in ranges.iter().enumerate() {
             if !range.is_finite() || self.hits.len() >= sensing.capacity {

@@ -10,7 +10,7 @@
 
 use rand::Rng;
 
-use super::map::{Map, path_length, segment_hits};
+use super::map::{EndpointError, Map, path_length, segment_hits};
 use crate::V2;
 
 /// The planner's parameters. Defaults: docs/planning.md.
@@ -76,12 +76,9 @@ pub enum GsaError {
         /// What it must be.
         rule: &'static str,
     },
-    /// The start or the goal is not finite or lies outside the box.
-    #[error("the {0} is outside the planning box")]
-    OutOfBounds(&'static str),
-    /// The goal lies inside an obstacle.
-    #[error("the goal lies inside an obstacle")]
-    GoalBlocked,
+    /// The start or the goal is not a place to plan between.
+    #[error(transparent)]
+    Endpoints(#[from] EndpointError),
     /// No agent's trajectory reached the goal without touching an obstacle.
     #[error(
         "no collision-free trajectory reached the goal ({collision_free} of {agents} collision-free, {reached} reached the goal)"
@@ -317,15 +314,7 @@ pub fn plan(
 ) -> Result<Plan, GsaError> {
     check(params)?;
     let map = &*map.opened_at(start);
-    if !(start.is_finite() && map.bounds.contains(start)) {
-        return Err(GsaError::OutOfBounds("start"));
-    }
-    if !(goal.is_finite() && map.bounds.contains(goal)) {
-        return Err(GsaError::OutOfBounds("goal"));
-    }
-    if map.inside_obstacle(goal) {
-        return Err(GsaError::GoalBlocked);
-    }
+    map.check_endpoints(start, goal)?;
     let penalty = params.penalty.unwrap_or(10.0 * map.bounds.diagonal());
     let mut swarm = Swarm::new(start, params, rng);
     let bodies = swarm.mass.len();
@@ -502,9 +491,15 @@ mod tests {
         let map = field(&[(5.0, 5.0, 1.0)]);
         let p = GsaParams::default();
         let inside = plan(V2::new(1.0, 1.0), V2::new(5.2, 5.0), &map, &p, &mut rng(1));
-        assert_eq!(inside.unwrap_err(), GsaError::GoalBlocked);
+        assert_eq!(
+            inside.unwrap_err(),
+            GsaError::Endpoints(EndpointError::GoalBlocked)
+        );
         let outside = plan(V2::new(-1.0, 1.0), V2::new(8.0, 8.0), &map, &p, &mut rng(1));
-        assert_eq!(outside.unwrap_err(), GsaError::OutOfBounds("start"));
+        assert_eq!(
+            outside.unwrap_err(),
+            GsaError::Endpoints(EndpointError::OutOfBounds("start"))
+        );
         let nan = plan(
             V2::new(1.0, 1.0),
             V2::new(f32::NAN, 8.0),
@@ -512,7 +507,10 @@ mod tests {
             &p,
             &mut rng(1),
         );
-        assert_eq!(nan.unwrap_err(), GsaError::OutOfBounds("goal"));
+        assert_eq!(
+            nan.unwrap_err(),
+            GsaError::Endpoints(EndpointError::OutOfBounds("goal"))
+        );
         let none = GsaParams { agents: 0, ..p };
         assert!(matches!(
             plan(

@@ -29,6 +29,14 @@ impl Bounds {
         )
     }
 
+    /// The box shrunk by `by` metres on every side (where the centre of a disc of radius `by` may be).
+    pub fn inset(&self, by: f32) -> Bounds {
+        Bounds {
+            min: self.min + V2::new(by, by),
+            max: self.max - V2::new(by, by),
+        }
+    }
+
     /// Length of the box's diagonal.
     pub fn diagonal(&self) -> f32 {
         (self.max - self.min).length()
@@ -41,6 +49,17 @@ impl Bounds {
             && self.min.x < self.max.x
             && self.min.y < self.max.y
     }
+}
+
+/// Why a planner cannot plan between a start and a goal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum EndpointError {
+    /// The start or the goal is not finite or lies outside the box.
+    #[error("the {0} is outside the planning box")]
+    OutOfBounds(&'static str),
+    /// The goal lies inside an obstacle.
+    #[error("the goal lies inside an obstacle")]
+    GoalBlocked,
 }
 
 /// Disc obstacles inside a box, as a point robot sees them: every disc already grown by the robot's radius and
@@ -81,8 +100,8 @@ pub fn segment_hits(a: V2, b: V2, disc: &Disc) -> bool {
 }
 
 impl Map {
-    /// The same map with every disc's radius grown by `by` metres.
-    pub fn grown(&self, by: f32) -> Map {
+    /// The same map with every disc's radius replaced by `radius(disc)`.
+    fn with_radii(&self, radius: impl Fn(&Disc) -> f32) -> Map {
         Map {
             bounds: self.bounds,
             discs: self
@@ -90,10 +109,29 @@ impl Map {
                 .iter()
                 .map(|d| Disc {
                     centre: d.centre,
-                    radius: d.radius + by,
+                    radius: radius(d),
                 })
                 .collect(),
         }
+    }
+
+    /// The same map with every disc's radius grown by `by` metres.
+    pub fn grown(&self, by: f32) -> Map {
+        self.with_radii(|d| d.radius + by)
+    }
+
+    /// Whether `start` and `goal` are finite points of the box and the goal lies outside every obstacle.
+    pub fn check_endpoints(&self, start: V2, goal: V2) -> Result<(), EndpointError> {
+        if !(start.is_finite() && self.bounds.contains(start)) {
+            return Err(EndpointError::OutOfBounds("start"));
+        }
+        if !(goal.is_finite() && self.bounds.contains(goal)) {
+            return Err(EndpointError::OutOfBounds("goal"));
+        }
+        if self.inside_obstacle(goal) {
+            return Err(EndpointError::GoalBlocked);
+        }
+        Ok(())
     }
 
     /// Whether the point `p` lies strictly inside an obstacle.
@@ -121,17 +159,7 @@ impl Map {
         if !self.inside_obstacle(start) {
             return Cow::Borrowed(self);
         }
-        Cow::Owned(Map {
-            bounds: self.bounds,
-            discs: self
-                .discs
-                .iter()
-                .map(|d| Disc {
-                    centre: d.centre,
-                    radius: d.radius.min((start - d.centre).length()),
-                })
-                .collect(),
-        })
+        Cow::Owned(self.with_radii(|d| d.radius.min((start - d.centre).length())))
     }
 
     /// Index of the first segment of `path` (segment `i` joins points `i` and `i + 1`) that is not free, if any.

@@ -6,7 +6,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use super::map::{Map, path_length};
+use super::map::{EndpointError, Map, path_length};
 use crate::V2;
 
 /// Most grid cells a search may use (about 40 MB of search state).
@@ -15,12 +15,9 @@ pub const MAX_CELLS: usize = 4_000_000;
 /// Why there is no reference path.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum SearchError {
-    /// The start or the goal is not finite or lies outside the box.
-    #[error("the {0} is outside the planning box")]
-    OutOfBounds(&'static str),
-    /// The goal lies inside an obstacle.
-    #[error("the goal lies inside an obstacle")]
-    GoalBlocked,
+    /// The start or the goal is not a place to plan between.
+    #[error(transparent)]
+    Endpoints(#[from] EndpointError),
     /// The resolution is not positive or the grid would exceed [`MAX_CELLS`].
     #[error("a grid of resolution {0} m over this box is too fine or not positive")]
     Resolution(f32),
@@ -85,15 +82,7 @@ pub fn shortest_path(
     resolution: f32,
 ) -> Result<Vec<V2>, SearchError> {
     let map = &*map.opened_at(start);
-    if !(start.is_finite() && map.bounds.contains(start)) {
-        return Err(SearchError::OutOfBounds("start"));
-    }
-    if !(goal.is_finite() && map.bounds.contains(goal)) {
-        return Err(SearchError::OutOfBounds("goal"));
-    }
-    if map.inside_obstacle(goal) {
-        return Err(SearchError::GoalBlocked);
-    }
+    map.check_endpoints(start, goal)?;
     let size = map.bounds.max - map.bounds.min;
     let (cols, rows) = ((size.x / resolution).ceil(), (size.y / resolution).ceil());
     if !(resolution > 0.0 && cols * rows <= MAX_CELLS as f32) {
@@ -248,11 +237,11 @@ mod tests {
         );
         assert_eq!(
             shortest_path(V2::new(-4.0, -4.0), V2::new(2.0, 0.0), &m, 0.1),
-            Err(SearchError::GoalBlocked)
+            Err(SearchError::Endpoints(EndpointError::GoalBlocked))
         );
         assert_eq!(
             shortest_path(V2::new(-6.0, 0.0), V2::ZERO, &m, 0.1),
-            Err(SearchError::OutOfBounds("start"))
+            Err(SearchError::Endpoints(EndpointError::OutOfBounds("start")))
         );
         assert_eq!(
             shortest_path(V2::new(-4.0, 0.0), V2::ZERO, &m, 0.0),

@@ -15,20 +15,12 @@ pub const REFERENCE_RESOLUTION: f32 = 0.05;
 /// The reference optimum from `start` to `goal` for a robot of `radius` among `discs` in `bounds`, or `None`
 /// when the search finds no way (a goal walled in, a start inside an obstacle's reach).
 pub fn optimum(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> Option<f32> {
+    // The robot's centre is kept one radius from the arena's edges.
     let map = Map {
-        bounds,
+        bounds: bounds.inset(radius),
         discs: discs.to_vec(),
     }
     .grown(radius);
-    // The robot's centre is kept one radius from the arena's edges.
-    let inset = V2::new(radius, radius);
-    let map = Map {
-        bounds: Bounds {
-            min: bounds.min + inset,
-            max: bounds.max - inset,
-        },
-        ..map
-    };
     let start = map.bounds.clamp(start);
     shortest_length(start, goal, &map, REFERENCE_RESOLUTION).ok()
 }
