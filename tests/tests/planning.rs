@@ -71,6 +71,21 @@ fn closest_approach(out: &Path, config: &str) -> Vec<(String, f64)> {
         .collect()
 }
 
+/// Eight cylinders of radius 0.3 m whose centres lie 0.55 m round `(x, y)`: they overlap, walling the point off.
+fn ring_round(x: f64, y: f64) -> String {
+    (0..8)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::FRAC_PI_4;
+            format!(
+                "    <cylinder id=\"w{k}\" radius=\"0.3\" height=\"0.5\" movable=\"false\"><body position=\"{},{},0\" \
+                 orientation=\"0,0,0\" /></cylinder>\n",
+                x + 0.55 * a.cos(),
+                y + 0.55 * a.sin()
+            )
+        })
+        .collect()
+}
+
 #[test]
 fn a_gsa_robot_finds_the_hidden_cylinders_replans_and_arrives_the_same_way_for_a_seed() {
     let runs: Vec<tempfile::TempDir> = (0..2)
@@ -161,8 +176,16 @@ fn bad_planning_settings_are_refused_with_their_place() {
             "goals=\"5.5,5.5\"",
             "is inside obstacle `h1`",
         ),
+        (
+            "goals=\"9,9\"",
+            "goals=\"8.5,8.5\"",
+            "the goal (8.5, 8.5) of robot `robot` cannot be reached from its start (1, 1): obstacles wall it off",
+        ),
     ] {
-        let config = hidden_with(dir.path(), |text| text.replace(from, to));
+        let config = hidden_with(dir.path(), |text| {
+            text.replace(from, to)
+                .replace("  </arena>", &format!("{}  </arena>", ring_round(8.5, 8.5)))
+        });
         let run = dir.path().join("run").display().to_string();
         let outcome = swarm(&["run", &config, "--out", &run, "--overwrite"]);
         assert!(!outcome.output.status.success(), "{to} was accepted");

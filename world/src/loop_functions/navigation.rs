@@ -48,7 +48,7 @@ use crate::loop_functions::{LoopFunctions, LoopFunctionsParams};
 use crate::rng::{Purpose, stream};
 
 mod planning;
-use planning::{Totals, TripFigures, optimum};
+use planning::{Totals, TripFigures, optimum, walled_off};
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "navigation_loop_functions";
@@ -58,6 +58,8 @@ const _: () = assert!(PAYLOAD <= swarm_contract::mail::MAIL_PAYLOAD_BYTES);
 /// The file, in the run folder, with one row per goal reached.
 pub const OUTPUT: &str = "navigation.csv";
 const ATTEMPTS: usize = 10_000;
+/// Random goals drawn for one robot before giving up on finding one it can reach.
+const REACHABLE_ATTEMPTS: usize = 100;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Layout {
@@ -241,6 +243,17 @@ impl Navigation {
         None
     }
 
+    /// A random goal as [`Navigation::draw`] gives, that obstacles do not wall off from `start`.
+    fn draw_reachable(&mut self, start: V2, radius: f32, taken: &[V2], apart: f32) -> Option<V2> {
+        for _ in 0..REACHABLE_ATTEMPTS {
+            let goal = self.draw(radius, taken, apart)?;
+            if !walled_off(start, goal, &self.map, self.bounds, radius) {
+                return Some(goal);
+            }
+        }
+        None
+    }
+
     fn starts(&mut self, arena: &mut Arena) -> Result<(), WorldError> {
         let n = arena.robots.len();
         for i in 0..n {
@@ -314,12 +327,14 @@ impl Navigation {
                 Goals::Antipodal => self.center * 2.0 - to_v2(robot.position),
                 Goals::Random => {
                     let apart = 2.0 * radius + 2.0 * self.clearance;
-                    self.draw(radius, &goals, apart).ok_or_else(|| {
-                        self.error(format!(
-                            "no free goal for robot `{}` in the area",
-                            robot.name
-                        ))
-                    })?
+                    let start = to_v2(robot.position);
+                    self.draw_reachable(start, radius, &goals, apart)
+                        .ok_or_else(|| {
+                            self.error(format!(
+                                "no free goal for robot `{}` in the area that it can reach",
+                                robot.name
+                            ))
+                        })?
                 }
             };
             self.check_goal(arena, i, goal)?;
@@ -336,7 +351,8 @@ impl Navigation {
         Ok(())
     }
 
-    /// A goal must lie in the arena with room for the robot, outside every obstacle's clearance.
+    /// A goal must lie in the arena with room for the robot, outside every obstacle's clearance, and not be walled
+    /// off from the robot's start by obstacles (the reference search of `planning` decides).
     fn check_goal(&self, arena: &Arena, robot: usize, goal: V2) -> Result<(), WorldError> {
         let r = &arena.robots[robot];
         let radius = r.body.radius;
@@ -365,6 +381,13 @@ impl Navigation {
             return Err(self.error(format!(
                 "the goal ({}, {}) of robot `{}` is inside obstacle `{name}` (or within {} m of it)",
                 goal.x, goal.y, r.name, self.clearance
+            )));
+        }
+        let start = to_v2(r.position);
+        if walled_off(start, goal, &self.map, self.bounds, radius) {
+            return Err(self.error(format!(
+                "the goal ({}, {}) of robot `{}` cannot be reached from its start ({}, {}): obstacles wall it off",
+                goal.x, goal.y, r.name, start.x, start.y
             )));
         }
         Ok(())
@@ -456,7 +479,7 @@ impl Navigation {
             return;
         }
         let radius = arena.robots[robot].body.radius;
-        let next = self.draw(radius, &[], 0.0);
+        let next = self.draw_reachable(here, radius, &[], 0.0);
         let trip = &mut self.trips[robot];
         match next {
             Some(goal) => {

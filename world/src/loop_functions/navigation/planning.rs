@@ -5,24 +5,36 @@
 use serde_json::{Map as JsonMap, Value, json};
 use swarm_navigation::V2;
 use swarm_navigation::apf::Disc;
-use swarm_navigation::planning::theta_star::shortest_length;
+use swarm_navigation::planning::theta_star::{SearchError, shortest_length};
 use swarm_navigation::planning::{Bounds, Map};
 use swarm_navigation::wire::PlanReport;
 
 /// Grid of the reference search (m).
 pub const REFERENCE_RESOLUTION: f32 = 0.05;
 
-/// The reference optimum from `start` to `goal` for a robot of `radius` among `discs` in `bounds`, or `None`
-/// when the search finds no way (a goal walled in, a start inside an obstacle's reach).
-pub fn optimum(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> Option<f32> {
-    // The robot's centre is kept one radius from the arena's edges.
-    let map = Map {
+/// The map a robot of `radius` among `discs` in `bounds` moves in, as a point: discs grown by the radius, and
+/// the box shrunk by it (the centre keeps one radius from the arena's edges).
+fn robot_map(discs: &[Disc], bounds: Bounds, radius: f32) -> Map {
+    Map {
         bounds: bounds.inset(radius),
         discs: discs.to_vec(),
     }
-    .grown(radius);
-    let start = map.bounds.clamp(start);
-    shortest_length(start, goal, &map, REFERENCE_RESOLUTION).ok()
+    .grown(radius)
+}
+
+/// The reference optimum from `start` to `goal` for a robot of `radius` among `discs` in `bounds`, or `None`
+/// when the search finds no way (a goal walled in) or cannot search (a map too large for its grid).
+pub fn optimum(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> Option<f32> {
+    let map = robot_map(discs, bounds, radius);
+    shortest_length(map.bounds.clamp(start), goal, &map, REFERENCE_RESOLUTION).ok()
+}
+
+/// Whether obstacles wall `goal` off from `start` for a robot of `radius` (`false` when the search cannot
+/// tell: a map too large for its grid).
+pub fn walled_off(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> bool {
+    let map = robot_map(discs, bounds, radius);
+    shortest_length(map.bounds.clamp(start), goal, &map, REFERENCE_RESOLUTION)
+        == Err(SearchError::Unreachable)
 }
 
 /// One finished trip's planning figures.
@@ -121,6 +133,28 @@ mod tests {
         };
         let round = optimum(V2::new(1.0, 5.0), V2::new(9.0, 5.0), &[disc], bounds, 0.1).unwrap();
         assert!(round > 8.2 && round < 8.6, "{round}");
+        assert!(!walled_off(
+            V2::new(1.0, 5.0),
+            V2::new(9.0, 5.0),
+            &[disc],
+            bounds,
+            0.1
+        ));
+        // A ring of discs round the goal.
+        let ring: Vec<Disc> = (0..8)
+            .map(|k| Disc {
+                centre: V2::new(5.0, 5.0)
+                    + V2::from_angle(k as f32 * std::f32::consts::FRAC_PI_4) * 0.55,
+                radius: 0.3,
+            })
+            .collect();
+        assert!(walled_off(
+            V2::new(1.0, 5.0),
+            V2::new(5.0, 5.0),
+            &ring,
+            bounds,
+            0.1
+        ));
     }
 
     #[test]
