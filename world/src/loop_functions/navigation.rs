@@ -86,6 +86,10 @@ struct Trip {
     started: u64,
     path: f64,
     last: Option<V2>,
+    /// Heading at the last tick it was in the run.
+    last_heading: Option<f32>,
+    /// Sum of the heading changes on this task (rad): how much the robot turned.
+    turning: f64,
     /// Reached in single tasking: no further task.
     done: bool,
     /// Whether the robot has been in the run (a robot joining later starts its task when it joins).
@@ -126,6 +130,8 @@ pub struct Navigation {
     last_arrival_tick: u64,
     flowtime_ticks: u64,
     completed_path: f64,
+    completed_turning: f64,
+    peak_turn_rate: f32,
     min_separation: f32,
     min_clearance: f32,
     stop_events: u64,
@@ -207,6 +213,8 @@ impl Navigation {
             last_arrival_tick: 0,
             flowtime_ticks: 0,
             completed_path: 0.0,
+            completed_turning: 0.0,
+            peak_turn_rate: 0.0,
             min_separation: f32::INFINITY,
             min_clearance: f32::INFINITY,
             stop_events: 0,
@@ -215,7 +223,7 @@ impl Navigation {
             repeat_seconds: r.positive("repeat", 1.0)?,
             location: params.location.clone(),
             output: String::from(
-                "tick,robot,task,goal_x,goal_y,duration_s,path_m,optimum_m,plans,failed_plans,replans,\
+                "tick,robot,task,goal_x,goal_y,duration_s,path_m,turning_rad,optimum_m,plans,failed_plans,replans,\
                  collision_free_fraction,planned_m,followed_m\n",
             ),
         }))
@@ -450,11 +458,12 @@ impl Navigation {
         self.last_arrival_tick = self.tick;
         self.flowtime_ticks += self.tick - trip.started;
         self.completed_path += trip.path;
+        self.completed_turning += trip.turning;
         let cell = |x: Option<String>| x.unwrap_or_default();
         let report = trip.report;
         let _ = writeln!(
             self.output,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             self.tick,
             robot,
             trip.seq,
@@ -462,6 +471,7 @@ impl Navigation {
             trip.goal.y,
             (self.tick - trip.started) as f64 / tps,
             trip.path,
+            trip.turning,
             cell(figures.optimum.map(|o| o.to_string())),
             cell(report.map(|r| r.plans.to_string())),
             cell(report.map(|r| r.failed.to_string())),
@@ -489,6 +499,7 @@ impl Navigation {
                 trip.seq += 1;
                 trip.started = self.tick;
                 trip.path = 0.0;
+                trip.turning = 0.0;
                 trip.last_sent = None;
             }
             None => trip.done = true,
@@ -567,6 +578,7 @@ impl LoopFunctions for Navigation {
             let trip = &mut self.trips[i];
             if !in_run {
                 trip.last = None;
+                trip.last_heading = None;
                 continue;
             }
             if !trip.seen {
@@ -575,11 +587,17 @@ impl LoopFunctions for Navigation {
                 trip.start = here;
             }
             let step = trip.last.map_or(0.0, |last| (here - last).length());
+            let turn = trip
+                .last_heading
+                .map_or(0.0, |last| swarm_navigation::vec2::wrap(r.heading - last).abs());
             trip.last = Some(here);
+            trip.last_heading = Some(r.heading);
             if trip.done {
                 continue;
             }
             trip.path += f64::from(step);
+            trip.turning += f64::from(turn);
+            self.peak_turn_rate = self.peak_turn_rate.max(turn / dt);
             let stalled = step / dt < self.stall_speed;
             if stalled && !trip.stalled && trip.path > 0.0 {
                 self.stop_events += 1;
@@ -665,6 +683,8 @@ impl LoopFunctions for Navigation {
             "makespan_s": (!self.continuous && arrived == robots && robots > 0)
                 .then(|| self.last_arrival_tick as f64 / tps),
             "mean_path_length_m": (self.arrivals > 0).then(|| self.completed_path / self.arrivals as f64),
+            "mean_turning_rad": (self.arrivals > 0).then(|| self.completed_turning / self.arrivals as f64),
+            "peak_turn_rate_rad_s": self.peak_turn_rate,
             "flowtime_s": self.flowtime_ticks as f64 / tps,
             "min_separation_m": finite(self.min_separation),
             "min_clearance_m": finite(self.min_clearance),
