@@ -8,6 +8,8 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod terminal_progress;
+
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
@@ -195,12 +197,14 @@ fn main() -> ExitCode {
         .with_ansi(std::io::stderr().is_terminal())
         .init();
     let cli = Cli::parse();
+    terminal_progress::install();
     let result = match cli.command {
         Command::Synth(args) => synth(&args),
         Command::Check(args) => check(&args),
         Command::Draw(args) => draw(&args),
         Command::Codegen(args) => codegen(&args),
     };
+    terminal_progress::finish();
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::Rejected) => ExitCode::from(1),
@@ -334,6 +338,7 @@ fn accepted<T>(
     result: Result<T, BuildError>,
     warnings: fn(&T) -> &[Diagnostic],
 ) -> Result<Option<T>> {
+    terminal_progress::finish();
     match result {
         Ok(value) => {
             print_diagnostics(warnings(&value));

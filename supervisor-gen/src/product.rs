@@ -6,6 +6,7 @@
 //! caller's normalisation left in them (1 under rule A5). The product of an empty list is the identity (C3).
 
 use crate::automaton::{Automaton, EventId, EventTable, ModelKind, StateId, Transition};
+use crate::progress;
 
 /// A product together with the component-state tuple of each of its states.
 #[derive(Debug, Clone)]
@@ -84,8 +85,12 @@ pub fn product_with_tuples(
     // Components moved by the transition being built: (component, new state).
     let mut moved: Vec<(usize, u32)> = Vec::with_capacity(arity);
     let strides: Option<Vec<usize>> = index.strides().map(<[usize]>::to_vec);
+    progress::stage(|| format!("product {}", result.name()));
     let mut x = 0usize;
     while x < index.len() {
+        if x > 0 && x.is_multiple_of(progress::STATES_PER_REPORT) {
+            progress::states(x);
+        }
         cur.copy_from_slice(index.tuple(x));
         let cur_key: usize = strides.as_ref().map_or(0, |st| {
             cur.iter().zip(st).map(|(&q, &w)| q as usize * w).sum()

@@ -94,6 +94,7 @@ impl SupcResult {
 /// make a state bad (A6). K is expected to be accessible, as products are.
 pub fn supc(k: &Automaton, g: &Automaton, g_of: &[StateId], events: &EventTable) -> SupcResult {
     let n = k.state_count();
+    crate::progress::stage(|| format!("SupC of {} ({n} states)", k.name()));
     let rev = ReverseAdjacency::new(k);
     let mut removed = vec![false; n];
     let mut records: Vec<RemovedState> = Vec::new();
@@ -164,6 +165,7 @@ pub fn supc(k: &Automaton, g: &Automaton, g_of: &[StateId], events: &EventTable)
                 record(&mut records, x, RemovalReason::Inaccessible, round);
             }
         }
+        crate::progress::round(round, records.len());
         if work.is_empty() {
             break;
         }

@@ -587,9 +587,9 @@ impl LoopFunctions for Navigation {
                 trip.start = here;
             }
             let step = trip.last.map_or(0.0, |last| (here - last).length());
-            let turn = trip
-                .last_heading
-                .map_or(0.0, |last| swarm_navigation::vec2::wrap(r.heading - last).abs());
+            let turn = trip.last_heading.map_or(0.0, |last| {
+                swarm_navigation::vec2::wrap(r.heading - last).abs()
+            });
             trip.last = Some(here);
             trip.last_heading = Some(r.heading);
             if trip.done {
