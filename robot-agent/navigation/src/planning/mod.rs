@@ -1,5 +1,5 @@
 //! Single-robot path planning among disc obstacles (paper D, docs/planning.md): the map a planner works in, the
-//! GSA planner, the any-angle grid search that serves as the reference optimum, a path follower, and reproducible test maps.
+//! GSA planner, the any-angle grid search that serves as the reference optimum, a path follower, reproducible test maps, and the tree planners (ORT and RRT) for a carried object's path.
 
 pub mod discovery;
 pub mod follow;
@@ -7,5 +7,6 @@ pub mod gsa;
 pub mod map;
 pub mod scattered;
 pub mod theta_star;
+pub mod tree;
 
 pub use map::{Bounds, Map};

@@ -1,4 +1,4 @@
-//! Reproducible test maps for planners (the benchmark's and `examples/gsa_eval.rs`'): discs scattered at a fixed
+//! Reproducible test maps for planners (the benchmark's and `examples/planner_eval.rs`'): discs scattered at a fixed
 //! density in a square whose side grows with their number, start and goal in opposite corners.
 
 use rand::{Rng, SeedableRng};

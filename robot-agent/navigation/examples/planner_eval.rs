@@ -1,6 +1,7 @@
-//! The planner-level figures of docs/planning.md: GSA against the Theta* reference on scattered maps of 10, 50
-//! and 200 discs (`MAPS` maps each, one GSA run per map and seed), as a Markdown table.
-//! `cargo run --release -p swarm-navigation --example gsa_eval [-- <g0> <alpha_g> <max_step> <goal_anchor>]`
+//! The planner-level figures of docs/planning.md, as Markdown tables: GSA, and the tree planners ORT and RRT,
+//! against the Theta* reference on scattered maps of 10, 50 and 200 discs (`MAPS` maps each, one run per map
+//! and seed). The optional arguments change GSA's parameters.
+//! `cargo run --release -p swarm-navigation --example planner_eval [-- <g0> <alpha_g> <max_step> <goal_anchor>]`
 
 use std::time::Instant;
 
@@ -10,6 +11,7 @@ use swarm_navigation::planning::gsa::{self, GsaParams};
 use swarm_navigation::planning::map::{path_length, shortcut};
 use swarm_navigation::planning::scattered::scattered;
 use swarm_navigation::planning::theta_star;
+use swarm_navigation::planning::tree::{self, Tree, TreeParams};
 
 const MAPS: u64 = 10;
 const SEEDS: u64 = 10;
@@ -83,5 +85,50 @@ fn main() {
             median(gsa_ms),
             median(ref_ms)
         );
+    }
+    trees();
+}
+
+/// ORT and RRT (steps of 0.2 m, the defaults) against Theta* on the same maps.
+fn trees() {
+    println!(
+        "\n| obstacles | tree | runs | success | median length/optimum | median nodes | median ms |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for obstacles in [10, 50, 200] {
+        for (label, kind) in [("ORT", Tree::Ort), ("RRT", Tree::Rrt)] {
+            let (mut runs, mut found) = (0, 0);
+            let (mut ratio, mut nodes, mut ms) = (vec![], vec![], vec![]);
+            for m in 0..MAPS {
+                let problem = scattered(obstacles, m);
+                let map = problem.map.grown(ROBOT_RADIUS);
+                let Ok(optimum) =
+                    theta_star::shortest_length(problem.start, problem.goal, &map, 0.05)
+                else {
+                    continue;
+                };
+                for seed in 0..SEEDS {
+                    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                    let clock = Instant::now();
+                    let params = TreeParams::default();
+                    let result =
+                        tree::plan(kind, problem.start, problem.goal, &map, &params, &mut rng);
+                    ms.push(clock.elapsed().as_secs_f64() * 1e3);
+                    runs += 1;
+                    if let Ok(plan) = result {
+                        found += 1;
+                        ratio.push(f64::from(plan.length / optimum));
+                        nodes.push(plan.nodes as f64);
+                    }
+                }
+            }
+            println!(
+                "| {obstacles} | {label} | {runs} | {:.0} % | {:.3} | {:.0} | {:.1} |",
+                100.0 * found as f64 / runs as f64,
+                median(ratio),
+                median(nodes),
+                median(ms)
+            );
+        }
     }
 }
