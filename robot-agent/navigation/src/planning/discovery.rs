@@ -195,6 +195,7 @@ pub fn fit_circle(points: &[V2]) -> Option<Disc> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::planning::map::Map;
 
     fn bounds() -> Bounds {
         Bounds {
@@ -205,20 +206,17 @@ mod tests {
 
     /// What a 24-ray ring at `position` facing +x reads of a disc, with nothing else in range (1 m).
     fn ring(position: V2, disc: &Disc) -> Vec<f32> {
+        let map = Map {
+            bounds: bounds(),
+            discs: vec![*disc],
+        };
         (0..24)
             .map(|k| {
-                let dir = V2::from_angle(std::f32::consts::TAU * k as f32 / 24.0);
-                // Ray-circle intersection, nearest positive root.
-                let oc = position - disc.centre;
-                let b = oc.dot(dir);
-                let c = oc.dot(oc) - disc.radius * disc.radius;
-                let h = b * b - c;
-                let t = -b - h.max(0.0).sqrt();
-                if h >= 0.0 && t > 0.0 && t <= 1.0 {
-                    t
-                } else {
-                    f32::INFINITY
-                }
+                map.ray(
+                    position,
+                    V2::from_angle(std::f32::consts::TAU * k as f32 / 24.0),
+                    1.0,
+                )
             })
             .collect()
     }

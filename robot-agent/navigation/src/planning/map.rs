@@ -162,6 +162,22 @@ impl Map {
         Cow::Owned(self.with_radii(|d| d.radius.min((start - d.centre).length())))
     }
 
+    /// Distance from `origin` along the unit vector `direction` to the first disc it meets within `range`, or
+    /// infinity: what an ideal range-finder ray reads (the box's edges are not seen).
+    pub fn ray(&self, origin: V2, direction: V2, range: f32) -> f32 {
+        self.discs
+            .iter()
+            .filter_map(|d| {
+                let oc = origin - d.centre;
+                let b = oc.dot(direction);
+                let c = oc.dot(oc) - d.radius * d.radius;
+                let h = b * b - c;
+                let t = -b - h.max(0.0).sqrt();
+                (h >= 0.0 && t >= 0.0 && t <= range).then_some(t)
+            })
+            .fold(f32::INFINITY, f32::min)
+    }
+
     /// Index of the first segment of `path` (segment `i` joins points `i` and `i + 1`) that is not free, if any.
     pub fn first_blocked_segment(&self, path: &[V2]) -> Option<usize> {
         path.windows(2).position(|w| !self.segment_free(w[0], w[1]))
@@ -244,6 +260,20 @@ mod tests {
         assert_eq!(map.discs[0].radius, 0.75);
         assert!(map.inside_obstacle(V2::new(2.7, 2.0)));
         assert!(!one_disc().inside_obstacle(V2::new(2.7, 2.0)));
+    }
+
+    #[test]
+    fn a_ray_reads_the_nearest_disc_within_range() {
+        let map = one_disc();
+        assert!((map.ray(V2::new(0.5, 2.0), V2::new(1.0, 0.0), 3.0) - 1.0).abs() < 1e-5);
+        assert_eq!(
+            map.ray(V2::new(0.5, 2.0), V2::new(1.0, 0.0), 0.9),
+            f32::INFINITY
+        );
+        assert_eq!(
+            map.ray(V2::new(0.5, 2.0), V2::new(-1.0, 0.0), 3.0),
+            f32::INFINITY
+        );
     }
 
     #[test]
