@@ -1,15 +1,13 @@
-//! The fast genetic allocator, FGA (A.5.3): one gene per available robot (0: keep exploring, j + 1: task j),
-//! one-point crossover, a mutation that swaps the tasks of two robots, a repair that makes every task's team
-//! feasible or empty (tasks in order of importance `u_j / W_j`), and (mu + lambda) elitist selection on the
-//! objective of [`Problem::objective`].
+//! The fast genetic allocator, FGA (A.5.3): the operators of [`crate::operators`] (one gene per available robot,
+//! one-point crossover, a swap mutation, the importance-ordered repair) with (mu + lambda) elitist selection on
+//! the scalar objective of [`Problem::objective`].
 
 use rand::Rng;
-use rand::seq::SliceRandom;
 
-use crate::model::{Kind, Problem};
-use crate::team::feasible;
+use crate::model::Problem;
+use crate::operators::{Genes, breed, by_importance, decode, random_genes, repair};
 
-/// The allocator's parameters: the levels the method's Taguchi design chose.
+/// The genetic parameters (of FGA and of the NSGA-II baseline): the levels the method's Taguchi design chose.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FgaParams {
     /// Population size P.
@@ -44,95 +42,10 @@ pub struct Allocation {
     pub objective: f64,
 }
 
-/// A chromosome: gene r is 0 for "explore" or j + 1 for task j.
-type Genes = Vec<u32>;
-
 #[derive(Clone)]
 struct Scored {
     genes: Genes,
     objective: f64,
-}
-
-/// Task indices by importance `u_j / W_j`, highest first (ties by index).
-fn by_importance(problem: &Problem) -> Vec<usize> {
-    let importance = |j: usize| {
-        let t = &problem.tasks[j];
-        f64::from(t.utility) / f64::from(t.window.max(1e-6))
-    };
-    let mut order: Vec<usize> = (0..problem.tasks.len()).collect();
-    order.sort_by(|&a, &b| importance(b).total_cmp(&importance(a)).then(a.cmp(&b)));
-    order
-}
-
-/// Makes every task's team feasible or empty, tasks in `order` (A.5.3's repair): excess robots are freed at
-/// random; a type-2 task with one type-1 robot takes a free type-1 robot, or else a free type-2 robot in its
-/// place, or else is given up. Robots are only ever taken from the free ones.
-fn repair(problem: &Problem, order: &[usize], genes: &mut Genes, rng: &mut impl Rng) {
-    let kind = |r: usize| problem.robots[r].kind;
-    let mut team = Vec::new();
-    let mut free = Vec::new();
-    for &j in order {
-        let gene = j as u32 + 1;
-        team.clear();
-        team.extend((0..genes.len()).filter(|&r| genes[r] == gene));
-        team.shuffle(rng);
-        let keep: &[usize] = match problem.tasks[j].kind {
-            Kind::One => &team[..team.len().min(1)],
-            Kind::Two => {
-                if let Some(i) = team.iter().position(|&r| kind(r) == Kind::Two) {
-                    team.swap(0, i);
-                    &team[..1]
-                } else if team.len() >= 2 {
-                    &team[..2]
-                } else if team.len() == 1 {
-                    free.clear();
-                    free.extend((0..genes.len()).filter(|&r| genes[r] == 0));
-                    free.shuffle(rng);
-                    let one = free.iter().copied().find(|&r| kind(r) == Kind::One);
-                    let two = free.iter().copied().find(|&r| kind(r) == Kind::Two);
-                    match (one, two) {
-                        (Some(r), _) => {
-                            genes[r] = gene;
-                            team.push(r);
-                            &team[..2]
-                        }
-                        (None, Some(r)) => {
-                            genes[r] = gene;
-                            genes[team[0]] = 0;
-                            team[0] = r;
-                            &team[..1]
-                        }
-                        (None, None) => &[],
-                    }
-                } else {
-                    &[]
-                }
-            }
-        };
-        let kept = keep.to_vec();
-        for &r in &team {
-            if !kept.contains(&r) {
-                genes[r] = 0;
-            }
-        }
-    }
-}
-
-fn decode(problem: &Problem, genes: &[u32]) -> (Vec<Option<usize>>, Vec<bool>) {
-    let assignment: Vec<Option<usize>> = genes
-        .iter()
-        .map(|&g| (g > 0).then(|| g as usize - 1))
-        .collect();
-    let performed = (0..problem.tasks.len())
-        .map(|j| {
-            let kinds: Vec<Kind> = (0..genes.len())
-                .filter(|&r| assignment[r] == Some(j))
-                .map(|r| problem.robots[r].kind)
-                .collect();
-            feasible(problem.tasks[j].kind, &kinds)
-        })
-        .collect();
-    (assignment, performed)
 }
 
 fn score(problem: &Problem, genes: Genes) -> Scored {
@@ -145,30 +58,21 @@ fn score(problem: &Problem, genes: Genes) -> Scored {
 
 /// Assigns `problem`'s robots to its tasks. A pure function of its inputs and `rng`'s state.
 pub fn allocate(problem: &Problem, params: &FgaParams, rng: &mut impl Rng) -> Allocation {
-    let (n, m) = (problem.robots.len(), problem.tasks.len() as u32);
     let order = by_importance(problem);
     let population = params.population.max(2);
     let mut pool: Vec<Scored> = (0..population)
         .map(|_| {
-            let mut genes: Genes = (0..n).map(|_| rng.random_range(0..=m)).collect();
+            let mut genes = random_genes(problem.robots.len(), problem.tasks.len(), rng);
             repair(problem, &order, &mut genes, rng);
             score(problem, genes)
         })
         .collect();
     for _ in 0..params.generations {
         for _ in 0..population / 2 {
-            let mut a = pool[rng.random_range(0..population)].genes.clone();
-            let mut b = pool[rng.random_range(0..population)].genes.clone();
-            if n >= 2 && rng.random_bool(params.crossover) {
-                let cut = rng.random_range(1..n);
-                a[cut..].swap_with_slice(&mut b[cut..]);
-            }
-            for child in [&mut a, &mut b] {
-                if rng.random_bool(params.mutation) {
-                    swap_two_tasks(child, rng);
-                }
-                repair(problem, &order, child, rng);
-            }
+            let a = pool[rng.random_range(0..population)].genes.clone();
+            let b = pool[rng.random_range(0..population)].genes.clone();
+            let rates = (params.crossover, params.mutation);
+            let (a, b) = breed(problem, &order, (a, b), rates, rng);
             pool.push(score(problem, a));
             pool.push(score(problem, b));
         }
@@ -186,57 +90,16 @@ pub fn allocate(problem: &Problem, params: &FgaParams, rng: &mut impl Rng) -> Al
     }
 }
 
-/// Swaps the genes of two robots with different genes, picked at random (no-op when all genes are equal).
-fn swap_two_tasks(genes: &mut Genes, rng: &mut impl Rng) {
-    if genes.len() < 2 {
-        return;
-    }
-    let i = rng.random_range(0..genes.len());
-    let others = genes.iter().filter(|&&g| g != genes[i]).count();
-    if others == 0 {
-        return;
-    }
-    let pick = rng.random_range(0..others);
-    let j = (0..genes.len())
-        .filter(|&j| genes[j] != genes[i])
-        .nth(pick)
-        .unwrap_or(i);
-    genes.swap(i, j);
-}
-
 #[cfg(test)]
 mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::model::{Robot, Task, Weights};
-
-    fn robot(kind: Kind, x: f32) -> Robot {
-        Robot {
-            kind,
-            position: (x, 0.0),
-            value: if kind == Kind::One { 1.0 } else { 2.0 },
-        }
-    }
-
-    fn task(kind: Kind, x: f32, utility: f32) -> Task {
-        Task {
-            kind,
-            position: (x, 1.0),
-            utility,
-            window: 100.0,
-        }
-    }
-
-    fn problem(robots: Vec<Robot>, tasks: Vec<Task>) -> Problem {
-        Problem {
-            robots,
-            tasks,
-            weights: Weights::default(),
-            diagonal: 14.14,
-        }
-    }
+    use crate::fixtures::{problem, robot, task};
+    use crate::model::Kind;
+    use crate::operators::decode;
+    use crate::team::feasible;
 
     fn run(p: &Problem, seed: u64) -> Allocation {
         allocate(
@@ -327,33 +190,6 @@ mod tests {
                 a.objective
             );
         }
-    }
-
-    #[test]
-    fn the_repair_leaves_no_partial_team_and_takes_only_free_robots() {
-        // Task 0 (type 2, most important) holds one type-1 robot; the only free robot is a type-2: it replaces
-        // the type-1, which becomes free. Task 1 (type 1) holds two robots: one is freed.
-        let p = problem(
-            vec![
-                robot(Kind::One, 0.0),
-                robot(Kind::Two, 1.0),
-                robot(Kind::One, 2.0),
-                robot(Kind::One, 3.0),
-            ],
-            vec![
-                Task {
-                    window: 10.0,
-                    ..task(Kind::Two, 0.0, 50.0)
-                },
-                task(Kind::One, 3.0, 10.0),
-            ],
-        );
-        let order = by_importance(&p);
-        assert_eq!(order, vec![0, 1]);
-        let mut genes = vec![1, 0, 2, 2];
-        repair(&p, &order, &mut genes, &mut ChaCha8Rng::seed_from_u64(3));
-        assert_eq!(genes[..2], [0, 1]);
-        assert_eq!(genes[2..].iter().filter(|&&g| g == 2).count(), 1);
     }
 
     proptest::proptest! {

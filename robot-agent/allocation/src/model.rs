@@ -75,10 +75,11 @@ impl Problem {
         f64::from((a.0 - b.0).hypot(a.1 - b.1))
     }
 
-    /// The objective F of an assignment (`assignment[r]`: robot r's task, if any) in which `performed[t]` says
-    /// whether task t has a feasible team. Normalised: utility by the sum of the open tasks' utilities,
-    /// distances by robots times the diagonal, values by the sum of the robots' values.
-    pub fn objective(&self, assignment: &[Option<usize>], performed: &[bool]) -> f64 {
+    /// The three normalised objectives of an assignment (`assignment[r]`: robot r's task, if any) in which
+    /// `performed[t]` says whether task t has a feasible team: utility of the performed tasks over that of all
+    /// open tasks (maximised), robot-task distances over robots times the diagonal, and values of the robots
+    /// used over all robots' values (both minimised).
+    pub fn objectives(&self, assignment: &[Option<usize>], performed: &[bool]) -> [f64; 3] {
         let upper: f64 = self.tasks.iter().map(|t| f64::from(t.utility)).sum();
         let values: f64 = self.robots.iter().map(|r| f64::from(r.value)).sum();
         let f1: f64 = self
@@ -95,10 +96,19 @@ impl Problem {
                 f3 += f64::from(self.robots[r].value);
             }
         }
-        let w = self.weights;
         let scaled = |x: f64, by: f64| if by > 0.0 { x / by } else { 0.0 };
-        w.utility * scaled(f1, upper)
-            - w.distance * scaled(f2, self.robots.len() as f64 * f64::from(self.diagonal))
-            - w.value * scaled(f3, values)
+        [
+            scaled(f1, upper),
+            scaled(f2, self.robots.len() as f64 * f64::from(self.diagonal)),
+            scaled(f3, values),
+        ]
+    }
+
+    /// The objective F of an assignment: the weighted sum of [`Problem::objectives`], utility counting for and
+    /// the costs against.
+    pub fn objective(&self, assignment: &[Option<usize>], performed: &[bool]) -> f64 {
+        let [f1, f2, f3] = self.objectives(assignment, performed);
+        let w = self.weights;
+        w.utility * f1 - w.distance * f2 - w.value * f3
     }
 }
