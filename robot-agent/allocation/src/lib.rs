@@ -10,6 +10,7 @@ pub mod instances;
 pub mod model;
 pub mod nsga2;
 pub mod operators;
+pub mod taguchi;
 pub mod team;
 
 pub use model::{Kind, Problem, Robot, Task, Weights};
