@@ -17,8 +17,8 @@
 //! the coordinator it heard last. Parameters: `method` (`amr_apf`, `dapf`, `apf`), the switches
 //! `adaptive_obstacles`, `adaptive_robots`, `gap_plugs`, `clusters` (true/false), `turn_rule`
 //! (`described`/`literal`), `plug_radius` (`enclosing`/`published`), the numbers `attraction`, `caution`,
-//! `influence`, `threshold_angle` (degrees), `cluster_radius`, `linkage`, `k_v`, `k_w`, `max_speed`,
-//! `max_turn_rate`, `min_distance` (defaults: docs/navigation.md), `stale` (ticks, default 10), and the buffer
+//! `robot_caution`, `influence`, `threshold_angle` (degrees), `cluster_radius`, `linkage`, `k_v`, `k_w`,
+//! `max_speed`, `max_turn_rate`, `min_distance` (defaults: docs/navigation.md), `stale` (ticks, default 10), and the buffer
 //! sizes `max_robots` and `max_obstacles` (default 1,024 each; entries beyond them are ignored).
 
 use swarm_contract::mail::{Address, FROM_WORLD, Mailbox};
@@ -76,6 +76,7 @@ fn apf_params(params: &Params) -> Result<ApfParams, ParamError> {
         },
         attraction: params.positive_f32_or("attraction", d.attraction)?,
         caution: params.non_negative_f32_or("caution", d.caution)?,
+        robot_caution: params.non_negative_f32_or("robot_caution", d.robot_caution)?,
         influence: params.positive_f32_or("influence", d.influence)?,
         threshold_angle: params
             .non_negative_f32_or("threshold_angle", d.threshold_angle.to_degrees())?

@@ -152,8 +152,10 @@ pub struct Params {
     pub parts: Parts,
     /// `F_A`: the attraction's magnitude; every other force is scaled relative to it.
     pub attraction: f32,
-    /// Caution distance `rho^c` in metres.
+    /// Caution distance `rho^c` in metres, for obstacles.
     pub caution: f32,
+    /// Caution distance towards other robots (single robots and clusters) in metres.
+    pub robot_caution: f32,
     /// Proximity radius minus caution radius, in metres.
     pub influence: f32,
     /// Threshold angle `phi` in radians.
@@ -185,6 +187,7 @@ impl Default for Params {
             parts: Parts::ALL,
             attraction: 1.0,
             caution: 0.1,
+            robot_caution: 0.1,
             influence: 0.6,
             threshold_angle: 30f32.to_radians(),
             cluster_radius: 2.0,
@@ -201,9 +204,19 @@ impl Default for Params {
 }
 
 impl Params {
-    /// The field a body of `body_radius` centred at `centre` makes for a robot of `own_radius`.
+    /// The field an obstacle of `body_radius` centred at `centre` makes for a robot of `own_radius`.
     pub fn field(&self, own_radius: f32, centre: V2, body_radius: f32) -> Field {
-        let caution = own_radius + body_radius + self.caution;
+        self.field_with(self.caution, own_radius, centre, body_radius)
+    }
+
+    /// The field another robot (or a cluster of robots) of `body_radius` centred at `centre` makes for a robot of
+    /// `own_radius`.
+    pub fn robot_field(&self, own_radius: f32, centre: V2, body_radius: f32) -> Field {
+        self.field_with(self.robot_caution, own_radius, centre, body_radius)
+    }
+
+    fn field_with(&self, distance: f32, own_radius: f32, centre: V2, body_radius: f32) -> Field {
+        let caution = own_radius + body_radius + distance;
         Field {
             centre,
             caution,

@@ -45,7 +45,7 @@ pub fn total_force(
     scratch: &mut Scratch,
 ) -> V2 {
     let others = neighbours.iter().filter(|n| n.id != me.id);
-    let field_of = |n: &Neighbour| params.field(me.radius, n.position, n.radius);
+    let field_of = |n: &Neighbour| params.robot_field(me.radius, n.position, n.radius);
     let d_min = params.min_distance;
     let f_a = params.attraction;
     match params.method {

@@ -54,7 +54,7 @@ pub fn gap_plugs(
             .iter()
             .filter(|n| n.status == Status::Stopped && n.id != me.id)
         {
-            let stopped = params.field(me.radius, n.position, n.radius);
+            let stopped = params.robot_field(me.radius, n.position, n.radius);
             out.extend(plug(&a, &stopped, params.plug_radius, params.influence));
         }
     }
@@ -135,7 +135,7 @@ pub fn cluster_obstacles(
             continue;
         }
         let circle = enclosing_circle(points);
-        let field = params.field(me.radius, circle.centre, circle.radius + widest);
+        let field = params.robot_field(me.radius, circle.centre, circle.radius + widest);
         if (me.goal - field.centre).length() > field.proximity {
             out.push(field);
         }
