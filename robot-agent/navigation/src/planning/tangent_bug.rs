@@ -9,7 +9,8 @@
 //! robot follows the boundary on that side, remembering `d_followed`, the least distance to the goal of any
 //! boundary point it has sensed while following, and goes back to the goal as soon as some point it can reach in
 //! the scan (along a ray, up to the clearance before its hit) is closer to the goal than that (`d_reach <
-//! d_followed`, the standard leave rule).
+//! d_followed`, the standard leave rule). The Bug2-like rule of exploration's text (leave once the robot is closer
+//! to the goal than where following began) is the alternative [`LeaveRule::Closer`].
 
 use crate::V2;
 
@@ -78,6 +79,18 @@ pub struct BugParams {
     pub standoff: f32,
     /// The other side's discontinuity must be this much better (m of heuristic) to switch sides.
     pub hysteresis: f32,
+    /// When boundary following ends.
+    pub leave: LeaveRule,
+}
+
+/// When a robot stops following a boundary and heads for the goal again.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LeaveRule {
+    /// TangentBug's: some point it can reach in the scan is closer to the goal than any boundary point it
+    /// sensed while following (`d_reach < d_followed`).
+    Reach,
+    /// Bug2-like: the robot is closer to the goal than where following began.
+    Closer,
 }
 
 impl Default for BugParams {
@@ -88,6 +101,7 @@ impl Default for BugParams {
             patience: 10,
             standoff: 1.3,
             hysteresis: 0.2,
+            leave: LeaveRule::Reach,
         }
     }
 }
@@ -112,6 +126,8 @@ pub enum Mode {
         side: Side,
         /// The least distance to the goal of a boundary point sensed while following.
         d_followed: f32,
+        /// The robot's distance to the goal when following began.
+        began: f32,
     },
 }
 
@@ -152,12 +168,23 @@ impl Bug {
         if (goal - x).length() < 1e-3 {
             return V2::ZERO;
         }
-        if let Mode::Following { side, d_followed } = self.mode {
+        if let Mode::Following {
+            side,
+            d_followed,
+            began,
+        } = self.mode
+        {
             let d_followed = d_followed.min(boundary_distance(scan, goal));
-            if reach(params, scan, goal) >= d_followed - 1e-3
-                && let Some(direction) = follow(params, scan, side)
-            {
-                self.mode = Mode::Following { side, d_followed };
+            let leave = match params.leave {
+                LeaveRule::Reach => reach(params, scan, goal) < d_followed - 1e-3,
+                LeaveRule::Closer => (goal - x).length() < began - 1e-3,
+            };
+            if !leave && let Some(direction) = follow(params, scan, side) {
+                self.mode = Mode::Following {
+                    side,
+                    d_followed,
+                    began,
+                };
                 return direction;
             }
             self.mode = Mode::ToGoal;
@@ -201,6 +228,7 @@ impl Bug {
         self.mode = Mode::Following {
             side,
             d_followed: boundary_distance(scan, goal),
+            began: (goal - scan.position).length(),
         };
         follow(params, scan, side).unwrap_or(V2::ZERO)
     }
@@ -397,7 +425,17 @@ mod tests {
         steps: usize,
         correction: Option<Correction>,
     ) -> Vec<V2> {
-        let params = BugParams::default();
+        drive_with(&BugParams::default(), map, start, goal, steps, correction)
+    }
+
+    fn drive_with(
+        params: &BugParams,
+        map: &Map,
+        start: V2,
+        goal: V2,
+        steps: usize,
+        correction: Option<Correction>,
+    ) -> Vec<V2> {
         let mut bug = Bug::new();
         let mut at = start;
         let mut visited = vec![at];
@@ -419,7 +457,7 @@ mod tests {
                 ranges: &ranges,
                 range: RANGE,
             };
-            let mut d = bug.step(&params, &scan, goal);
+            let mut d = bug.step(params, &scan, goal);
             if let Some(c) = correction {
                 d = c.apply(d, &scan);
             }
@@ -470,6 +508,18 @@ mod tests {
             "the body's edge came within {} m",
             closest - BODY
         );
+        // The Bug2-like leave rule gets round too.
+        let closer = BugParams {
+            leave: LeaveRule::Closer,
+            ..BugParams::default()
+        };
+        let visited = drive_with(&closer, &map, V2::new(3.5, 2.0), goal, 2000, None);
+        assert!(
+            (*visited.last().unwrap() - goal).length() < 0.1,
+            "stuck at {:?}",
+            visited.last()
+        );
+        assert!(closest_to_an_edge(&map, &visited) > BODY);
     }
 
     #[test]
