@@ -7,54 +7,30 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use swarm_allocation::fga::{self, FgaParams};
+use swarm_allocation::Problem;
+use swarm_allocation::fga::{self, Allocation, FgaParams};
 use swarm_allocation::instances::scattered;
 use swarm_allocation::nsga2;
+
+type Allocator = fn(&Problem, &FgaParams, &mut ChaCha8Rng) -> Allocation;
 
 fn allocation(c: &mut Criterion) {
     let mut group = c.benchmark_group("allocate");
     group.sample_size(20);
-    for (tasks, robots) in [(12, 9), (100, 50)] {
-        let p = scattered(tasks, robots, 7);
-        let mut seed = 0;
-        group.bench_with_input(
-            BenchmarkId::new("fga", format!("{tasks}x{robots}")),
-            &p,
-            |b, p| {
+    let allocators: [(&str, Allocator); 2] = [("fga", fga::allocate), ("nsga2", nsga2::allocate)];
+    for (label, allocate) in allocators {
+        for (tasks, robots) in [(12, 9), (100, 50)] {
+            let p = scattered(tasks, robots, 7);
+            let mut seed = 0;
+            let id = BenchmarkId::new(label, format!("{tasks}x{robots}"));
+            group.bench_with_input(id, &p, |b, p| {
                 b.iter(|| {
                     seed += 1;
-                    black_box(
-                        fga::allocate(
-                            p,
-                            &FgaParams::default(),
-                            &mut ChaCha8Rng::seed_from_u64(seed),
-                        )
-                        .objective,
-                    )
+                    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                    black_box(allocate(p, &FgaParams::default(), &mut rng).objective)
                 })
-            },
-        );
-    }
-    for (tasks, robots) in [(12, 9), (100, 50)] {
-        let p = scattered(tasks, robots, 7);
-        let mut seed = 0;
-        group.bench_with_input(
-            BenchmarkId::new("nsga2", format!("{tasks}x{robots}")),
-            &p,
-            |b, p| {
-                b.iter(|| {
-                    seed += 1;
-                    black_box(
-                        nsga2::allocate(
-                            p,
-                            &FgaParams::default(),
-                            &mut ChaCha8Rng::seed_from_u64(seed),
-                        )
-                        .objective,
-                    )
-                })
-            },
-        );
+            });
+        }
     }
     group.finish();
 }

@@ -168,9 +168,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::fixtures::{problem, robot, task};
-    use crate::model::Kind;
-    use crate::team::feasible;
+    use crate::fixtures::{five_robots_four_tasks, infeasible_team};
 
     #[test]
     fn dominance_and_fronts() {
@@ -201,31 +199,11 @@ mod tests {
 
     #[test]
     fn it_allocates_feasible_teams_reproducibly() {
-        let p = problem(
-            vec![
-                robot(Kind::One, 0.0),
-                robot(Kind::Two, 3.0),
-                robot(Kind::One, 5.0),
-                robot(Kind::One, 8.0),
-                robot(Kind::Two, 9.0),
-            ],
-            vec![
-                task(Kind::Two, 2.0, 40.0),
-                task(Kind::One, 7.0, 20.0),
-                task(Kind::Two, 9.0, 75.0),
-                task(Kind::One, 4.0, 10.0),
-            ],
-        );
+        let p = five_robots_four_tasks();
         let params = FgaParams::default();
         let a = allocate(&p, &params, &mut ChaCha8Rng::seed_from_u64(4));
         assert_eq!(a, allocate(&p, &params, &mut ChaCha8Rng::seed_from_u64(4)));
-        for j in 0..p.tasks.len() {
-            let team: Vec<Kind> = (0..p.robots.len())
-                .filter(|&r| a.assignment[r] == Some(j))
-                .map(|r| p.robots[r].kind)
-                .collect();
-            assert!(team.is_empty() || feasible(p.tasks[j].kind, &team));
-        }
+        assert_eq!(infeasible_team(&p, &a), None);
         // On this small problem it reaches FGA's (the enumerated) optimum too.
         let fga = crate::fga::allocate(&p, &params, &mut ChaCha8Rng::seed_from_u64(4));
         assert!(

@@ -372,24 +372,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::apf::Disc;
-    use crate::planning::map::Bounds;
-
-    fn field(discs: &[(f32, f32, f32)]) -> Map {
-        Map {
-            bounds: Bounds {
-                min: V2::ZERO,
-                max: V2::new(10.0, 10.0),
-            },
-            discs: discs
-                .iter()
-                .map(|&(x, y, r)| Disc {
-                    centre: V2::new(x, y),
-                    radius: r,
-                })
-                .collect(),
-        }
-    }
 
     fn rng(seed: u64) -> ChaCha8Rng {
         ChaCha8Rng::seed_from_u64(seed)
@@ -412,7 +394,7 @@ mod tests {
 
     #[test]
     fn in_the_open_every_trajectory_is_collision_free_and_the_plan_ends_at_the_goal() {
-        let map = field(&[]);
+        let map = Map::square_with(&[]);
         let (start, goal) = (V2::new(1.0, 1.0), V2::new(8.0, 6.0));
         let plan = plan(start, goal, &map, &GsaParams::default(), &mut rng(1)).unwrap();
         assert_eq!(plan.path.first(), Some(&start));
@@ -425,7 +407,7 @@ mod tests {
 
     #[test]
     fn plans_go_round_an_obstacle_on_the_straight_line() {
-        let map = field(&[(5.0, 5.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 5.0, 1.0)]);
         let (start, goal) = (V2::new(2.0, 5.0), V2::new(8.0, 5.0));
         let (found, failures) = plans(start, goal, &map, &GsaParams::default(), 10);
         assert!(
@@ -442,7 +424,7 @@ mod tests {
 
     #[test]
     fn with_the_goal_anchor_every_agent_runs_through_the_obstacle() {
-        let map = field(&[(5.0, 5.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 5.0, 1.0)]);
         let params = GsaParams {
             goal_anchor: true,
             ..GsaParams::default()
@@ -469,7 +451,7 @@ mod tests {
 
     #[test]
     fn the_obstacle_penalty_makes_an_agent_the_lightest() {
-        let map = field(&[(5.0, 5.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 5.0, 1.0)]);
         let params = GsaParams {
             goal_anchor: true,
             ..GsaParams::default()
@@ -488,7 +470,7 @@ mod tests {
 
     #[test]
     fn bad_inputs_are_errors() {
-        let map = field(&[(5.0, 5.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 5.0, 1.0)]);
         let p = GsaParams::default();
         let inside = plan(V2::new(1.0, 1.0), V2::new(5.2, 5.0), &map, &p, &mut rng(1));
         assert_eq!(
@@ -526,7 +508,7 @@ mod tests {
 
     #[test]
     fn a_start_inside_the_safety_margin_may_leave_it_but_not_go_deeper() {
-        let map = field(&[(5.0, 5.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 5.0, 1.0)]);
         let start = V2::new(5.0, 4.1); // 0.1 m inside the grown disc
         let (found, _) = plans(start, V2::new(5.0, 1.0), &map, &GsaParams::default(), 5);
         assert!(!found.is_empty());
@@ -544,7 +526,7 @@ mod tests {
             discs in proptest::collection::vec((0.5f32..9.5, 0.5f32..9.5, 0.1f32..0.8), 0..25),
             seed in 0u64..1000,
         ) {
-            let map = field(&discs);
+            let map = Map::square_with(&discs);
             let (start, goal) = (V2::new(0.2, 0.2), V2::new(9.8, 9.8));
             proptest::prop_assume!(map.free(start) && map.free(goal));
             let params = GsaParams { iterations: 200, ..GsaParams::default() };

@@ -184,6 +184,28 @@ impl Map {
     }
 }
 
+#[cfg(test)]
+impl Map {
+    /// A test map: the 10 m x 10 m box from the origin with discs `(x, y, radius)`.
+    pub(crate) fn square_with(discs: &[(f32, f32, f32)]) -> Map {
+        Map::box_with(V2::ZERO, V2::new(10.0, 10.0), discs)
+    }
+
+    /// A test map: the box from `min` to `max` with discs `(x, y, radius)`.
+    pub(crate) fn box_with(min: V2, max: V2, discs: &[(f32, f32, f32)]) -> Map {
+        Map {
+            bounds: Bounds { min, max },
+            discs: discs
+                .iter()
+                .map(|&(x, y, radius)| Disc {
+                    centre: V2::new(x, y),
+                    radius,
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Length of a polyline.
 pub fn path_length(path: &[V2]) -> f32 {
     path.windows(2).map(|w| (w[1] - w[0]).length()).sum()

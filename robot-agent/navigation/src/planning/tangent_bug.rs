@@ -392,43 +392,16 @@ impl Correction {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::apf::Disc;
-    use crate::planning::map::{Bounds, Map};
+    use crate::planning::map::Map;
 
     const RAYS: usize = 24;
     const RANGE: f32 = 1.0;
     const STEP: f32 = 0.05;
     const BODY: f32 = 0.1;
 
-    fn field(discs: &[(f32, f32, f32)]) -> Map {
-        Map {
-            bounds: Bounds {
-                min: V2::ZERO,
-                max: V2::new(10.0, 10.0),
-            },
-            discs: discs
-                .iter()
-                .map(|&(x, y, r)| Disc {
-                    centre: V2::new(x, y),
-                    radius: r,
-                })
-                .collect(),
-        }
-    }
-
-    /// Drives a holonomic robot with TangentBug (and the correction, when given) from `start` until it is within
-    /// 0.1 m of `goal` or `steps` have passed; returns the positions visited.
+    /// Drives a holonomic robot with TangentBug (`params`, and the correction when given) from `start` until it
+    /// is within 0.1 m of `goal` or `steps` have passed; returns the positions visited.
     fn drive(
-        map: &Map,
-        start: V2,
-        goal: V2,
-        steps: usize,
-        correction: Option<Correction>,
-    ) -> Vec<V2> {
-        drive_with(&BugParams::default(), map, start, goal, steps, correction)
-    }
-
-    fn drive_with(
         params: &BugParams,
         map: &Map,
         start: V2,
@@ -470,6 +443,18 @@ mod tests {
         visited
     }
 
+    /// The drive ended at the goal and the body never touched a disc.
+    fn assert_arrived_untouched(map: &Map, visited: &[V2], goal: V2) {
+        let last = *visited.last().unwrap();
+        assert!((last - goal).length() < 0.1, "stuck at {last:?}");
+        let closest = closest_to_an_edge(map, visited);
+        assert!(
+            closest > BODY,
+            "the body's edge came within {} m",
+            closest - BODY
+        );
+    }
+
     fn closest_to_an_edge(map: &Map, visited: &[V2]) -> f32 {
         visited
             .iter()
@@ -483,8 +468,15 @@ mod tests {
 
     #[test]
     fn in_the_open_it_drives_straight_to_the_goal() {
-        let map = field(&[(8.0, 2.0, 0.5)]);
-        let visited = drive(&map, V2::new(1.0, 1.0), V2::new(5.0, 4.0), 500, None);
+        let map = Map::square_with(&[(8.0, 2.0, 0.5)]);
+        let visited = drive(
+            &BugParams::default(),
+            &map,
+            V2::new(1.0, 1.0),
+            V2::new(5.0, 4.0),
+            500,
+            None,
+        );
         let last = *visited.last().unwrap();
         assert!((last - V2::new(5.0, 4.0)).length() < 0.1);
         assert!(visited.len() <= 102, "{} steps for 5 m", visited.len());
@@ -494,32 +486,24 @@ mod tests {
     fn it_goes_round_a_wall_without_touching_it() {
         let wall: Vec<(f32, f32, f32)> =
             (0..7).map(|k| (2.0 + 0.6 * k as f32, 5.0, 0.35)).collect();
-        let map = field(&wall);
+        let map = Map::square_with(&wall);
         let goal = V2::new(4.0, 8.0);
-        let visited = drive(&map, V2::new(3.5, 2.0), goal, 2000, None);
-        assert!(
-            (*visited.last().unwrap() - goal).length() < 0.1,
-            "stuck at {:?}",
-            visited.last()
+        let visited = drive(
+            &BugParams::default(),
+            &map,
+            V2::new(3.5, 2.0),
+            goal,
+            2000,
+            None,
         );
-        let closest = closest_to_an_edge(&map, &visited);
-        assert!(
-            closest > BODY,
-            "the body's edge came within {} m",
-            closest - BODY
-        );
+        assert_arrived_untouched(&map, &visited, goal);
         // The Bug2-like leave rule gets round too.
         let closer = BugParams {
             leave: LeaveRule::Closer,
             ..BugParams::default()
         };
-        let visited = drive_with(&closer, &map, V2::new(3.5, 2.0), goal, 2000, None);
-        assert!(
-            (*visited.last().unwrap() - goal).length() < 0.1,
-            "stuck at {:?}",
-            visited.last()
-        );
-        assert!(closest_to_an_edge(&map, &visited) > BODY);
+        let visited = drive(&closer, &map, V2::new(3.5, 2.0), goal, 2000, None);
+        assert_arrived_untouched(&map, &visited, goal);
     }
 
     #[test]
@@ -532,21 +516,18 @@ mod tests {
                 (5.0 + 1.3 * a.cos(), 4.0 + 1.3 * a.sin(), 0.3)
             })
             .collect();
-        let map = field(&cup);
+        let map = Map::square_with(&cup);
         let goal = V2::new(5.0, 8.0);
         let visited = drive(
+            &BugParams::default(),
             &map,
             V2::new(5.0, 4.0),
             goal,
             4000,
             Some(Correction::default()),
         );
-        assert!(
-            (*visited.last().unwrap() - goal).length() < 0.1,
-            "stuck at {:?}",
-            visited.last()
-        );
-        assert!(closest_to_an_edge(&map, &visited) > BODY);
+        // Measured: 139 steps of 5 cm, 64 of them following the cup's inside and out round its rim.
+        assert_arrived_untouched(&map, &visited, goal);
     }
 
     #[test]

@@ -170,23 +170,9 @@ mod tests {
     use std::f32::consts::PI;
 
     use super::*;
-    use crate::apf::Disc;
-    use crate::planning::map::Bounds;
 
     fn map(discs: &[(f32, f32, f32)]) -> Map {
-        Map {
-            bounds: Bounds {
-                min: V2::new(-5.0, -5.0),
-                max: V2::new(5.0, 5.0),
-            },
-            discs: discs
-                .iter()
-                .map(|&(x, y, r)| Disc {
-                    centre: V2::new(x, y),
-                    radius: r,
-                })
-                .collect(),
-        }
+        Map::box_with(V2::new(-5.0, -5.0), V2::new(5.0, 5.0), discs)
     }
 
     #[test]

@@ -312,24 +312,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::apf::Disc;
-    use crate::planning::map::Bounds;
-
-    fn field(discs: &[(f32, f32, f32)]) -> Map {
-        Map {
-            bounds: Bounds {
-                min: V2::ZERO,
-                max: V2::new(10.0, 10.0),
-            },
-            discs: discs
-                .iter()
-                .map(|&(x, y, r)| Disc {
-                    centre: V2::new(x, y),
-                    radius: r,
-                })
-                .collect(),
-        }
-    }
 
     fn run(tree: Tree, map: &Map, start: V2, goal: V2, seed: u64) -> Result<TreePlan, TreeError> {
         plan(
@@ -349,7 +331,7 @@ mod tests {
 
     #[test]
     fn in_sight_the_path_is_the_straight_line_in_steps() {
-        let map = field(&[(5.0, 8.0, 1.0)]);
+        let map = Map::square_with(&[(5.0, 8.0, 1.0)]);
         let (start, goal) = (V2::new(1.0, 1.0), V2::new(4.0, 5.0));
         for tree in [Tree::Ort, Tree::Rrt] {
             let plan = run(tree, &map, start, goal, 1).unwrap();
@@ -364,7 +346,7 @@ mod tests {
     fn round_a_wall_ort_paths_are_shorter_than_rrt_paths_with_more_nodes() {
         // A wall of discs across the middle with a gap near one end.
         let wall: Vec<(f32, f32, f32)> = (0..8).map(|k| (1.0 + k as f32, 5.0, 0.55)).collect();
-        let map = field(&wall);
+        let map = Map::square_with(&wall);
         let (start, goal) = (V2::new(3.0, 1.5), V2::new(3.0, 8.5));
         let (mut ort, mut rrt) = (Vec::new(), Vec::new());
         for seed in 0..10 {
@@ -403,7 +385,7 @@ mod tests {
                 (5.0 + 2.0 * a.cos(), 5.0 + 2.0 * a.sin(), 0.6)
             })
             .collect();
-        let map = field(&ring);
+        let map = Map::square_with(&ring);
         let params = TreeParams {
             iterations: 500,
             ..TreeParams::default()
@@ -464,7 +446,7 @@ mod tests {
             seed in 0u64..1000,
             ort in proptest::bool::ANY,
         ) {
-            let map = field(&discs);
+            let map = Map::square_with(&discs);
             let (start, goal) = (V2::new(0.2, 0.2), V2::new(9.8, 9.8));
             proptest::prop_assume!(map.free(start) && map.free(goal));
             let tree = if ort { Tree::Ort } else { Tree::Rrt };
