@@ -11,6 +11,7 @@ pub mod events;
 pub mod files;
 pub mod messages;
 pub mod snapshot;
+pub mod trails;
 pub mod trajectory;
 
 use swarm_contract::run_dir::{SUMMARY_FILE, TRAJECTORY_FILE};
@@ -36,6 +37,7 @@ pub struct Recorder {
     files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
     loop_output: Option<LoopOutput>,
+    trails: trails::Trails,
 }
 
 /// The loop functions' own output file, written on the tick thread: a short line per tick at most, and only for
@@ -98,6 +100,7 @@ impl Recorder {
             files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
             loop_output,
+            trails: trails::Trails::default(),
         })
     }
 
@@ -148,6 +151,12 @@ impl Recorder {
             self.record_fault(tick, robot.index(), name);
         }
         PoseRow::capture(&world.arena, |row| self.files.push(RecordRow::Pose(row)));
+        let positions = world
+            .arena
+            .robots
+            .iter()
+            .map(|r| (r.present && r.alive && !r.removed).then_some(r.position));
+        self.trails.sample(tick, positions);
         self.files.end_batch()?;
         if self.snapshot_ticks.contains(&world.tick()) {
             self.snapshot(world)?;
@@ -157,7 +166,8 @@ impl Recorder {
 
     fn snapshot(&self, world: &World) -> Result<(), WorldError> {
         let tick = world.tick();
-        snapshot::render(world, &swarm_contract::run_dir::snapshot(&self.dir, tick))
+        let path = swarm_contract::run_dir::snapshot(&self.dir, tick);
+        snapshot::render(world, &self.trails, &path)
     }
 
     /// Returns once every row recorded so far is in its file. The world calls it before it reports a scheduled

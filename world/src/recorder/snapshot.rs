@@ -1,6 +1,7 @@
 //! PNG snapshots of the arena drawn with tiny-skia, seen from above with +Y up: the floor as the ground sensors see
-//! it (sampled every `FLOOR_SAMPLE` metres), the pheromone heat map, obstacles, targets, lights, and robots in their
-//! LED colours with a heading tick (dead robots dark grey; a red dot marks a carried target).
+//! it (sampled every `FLOOR_SAMPLE` metres), the pheromone heat map, each robot's trail so far (thin blue lines,
+//! `trails`), obstacles, targets, lights, and robots in their LED colours with a heading tick (dead robots dark
+//! grey; a red dot marks a carried target).
 
 use std::path::Path;
 
@@ -12,6 +13,8 @@ use crate::entities::TargetState;
 use crate::error::WorldError;
 use crate::geometry::{Placed, Shape, Vec2, unit};
 use crate::world::World;
+
+use super::trails::Trails;
 
 /// Pixels per metre of a snapshot.
 pub const PIXELS_PER_METRE: f32 = 100.0;
@@ -31,8 +34,8 @@ fn paint(r: u8, g: u8, b: u8, a: u8) -> Paint<'static> {
 /// Side of the floor sampling cells in metres.
 pub const FLOOR_SAMPLE: f32 = 0.05;
 
-/// Draws the world into a PNG file at `path`.
-pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
+/// Draws the world, with the robots' `trails`, into a PNG file at `path`.
+pub fn render(world: &World, trails: &Trails, path: &Path) -> Result<(), WorldError> {
     let arena = &world.arena;
     let err = |message: String| WorldError::Render {
         path: path.to_path_buf(),
@@ -59,6 +62,7 @@ pub fn render(world: &World, path: &Path) -> Result<(), WorldError> {
 
     draw_floor(world, &mut pixmap, tf);
     draw_pheromone(arena, &mut pixmap, tf);
+    draw_trails(arena, trails, &mut pixmap, tf);
     for o in &arena.obstacles {
         fill_placed(&mut pixmap, &o.placed, &paint(90, 90, 90, 255), tf);
     }
@@ -136,6 +140,27 @@ fn fill_placed(pixmap: &mut Pixmap, placed: &Placed, paint: &Paint, tf: Transfor
     };
     if let Some(path) = path {
         pixmap.fill_path(&path, paint, FillRule::Winding, tf, None);
+    }
+}
+
+/// Each robot's trail as a thin translucent line, broken where the robot was out of the run.
+fn draw_trails(arena: &Arena, trails: &Trails, pixmap: &mut Pixmap, tf: Transform) {
+    let stroke = Stroke {
+        width: 0.01,
+        ..Stroke::default()
+    };
+    let colour = paint(40, 90, 200, 120);
+    for index in 0..arena.robots.len() {
+        let mut pb = PathBuilder::new();
+        for piece in trails.pieces(index) {
+            pb.move_to(piece[0].x, piece[0].y);
+            for p in &piece[1..] {
+                pb.line_to(p.x, p.y);
+            }
+        }
+        if let Some(path) = pb.finish() {
+            pixmap.stroke_path(&path, &colour, &stroke, tf, None);
+        }
     }
 }
 
