@@ -18,8 +18,8 @@
 //! become found obstacles (`swarm_navigation::planning::discovery`). After each planner run the robot reports
 //! its statistics for the task to the world (`wire::PlanReport`).
 //!
-//! Parameters: `planner` (`gsa` or `theta_star`), `shortcut` (true/false: follow the plan with its corners cut
-//! where the line of sight allows, default true), `margin` (m kept from obstacles beyond the body, default
+//! Parameters: `planner` (`gsa` or `theta_star`), `shortcut` (true/false: follow the shortest free polyline
+//! through the plan's own points, default true), `margin` (m kept from obstacles beyond the body, default
 //! 0.1), the GSA's `agents`, `iterations`, `g0`, `alpha_g`, `kbest_final`, `initial_speed`, `max_step`,
 //! `goal_anchor` (true/false), `arrive_fraction`, `penalty` (0 for 10 times the box's diagonal), the reference
 //! planner's `resolution` (m, default 0.05), the follower's `lookahead`, `max_speed`, `max_turn_rate`, `k_w`,

@@ -211,25 +211,35 @@ pub fn path_length(path: &[V2]) -> f32 {
     path.windows(2).map(|w| (w[1] - w[0]).length()).sum()
 }
 
-/// `path` with every corner dropped whose neighbours see each other on `map` (greedy line-of-sight pruning from
-/// the start): never longer than `path`, free wherever `path` was.
+/// The shortest polyline through `path`'s own points, in their order, whose every segment is free on `map`: the
+/// consecutive segments of `path` are kept wherever nothing shorter is free. Never longer than `path`, free wherever
+/// `path` was. Quadratic in the points (a shortest path over the in-order visibility graph), so that a path that
+/// overshoots and comes back is cut where a greedy "farthest visible point" pruning would follow the overshoot.
 pub fn shortcut(path: &[V2], map: &Map) -> Vec<V2> {
-    let Some(&first) = path.first() else {
-        return Vec::new();
-    };
-    let mut out = vec![first];
-    let mut anchor = 0;
-    while anchor + 1 < path.len() {
-        let mut reach = anchor + 1;
-        for candidate in (anchor + 2..path.len()).rev() {
-            if map.segment_free(path[anchor], path[candidate]) {
-                reach = candidate;
-                break;
+    let n = path.len();
+    if n < 3 {
+        return path.to_vec();
+    }
+    let mut best = vec![f32::INFINITY; n];
+    let mut via = vec![0usize; n];
+    best[0] = 0.0;
+    for j in 1..n {
+        for i in 0..j {
+            let through = best[i] + (path[j] - path[i]).length();
+            // Consecutive points are always joined: the path itself is the fallback.
+            if through < best[j] && (i + 1 == j || map.segment_free(path[i], path[j])) {
+                best[j] = through;
+                via[j] = i;
             }
         }
-        out.push(path[reach]);
-        anchor = reach;
     }
+    let mut out = vec![path[n - 1]];
+    let mut at = n - 1;
+    while at != 0 {
+        at = via[at];
+        out.push(path[at]);
+    }
+    out.reverse();
     out
 }
 
@@ -307,6 +317,25 @@ mod tests {
         assert!(opened.segment_free(start, V2::new(2.0, 3.5)));
         assert!(!opened.segment_free(start, V2::new(2.0, 2.3)));
         assert!(matches!(map.opened_at(V2::new(0.5, 0.5)), Cow::Borrowed(_)));
+    }
+
+    #[test]
+    fn shortcut_cuts_an_overshoot_that_greedy_pruning_would_follow() {
+        // From (0.5, 2) past the disc to an overshoot at (3.8, 3.8), back to the goal (3, 2.4): the goal is hidden
+        // from the start, the overshoot is not, so greedy pruning went start -> overshoot -> goal.
+        let map = one_disc();
+        let path = [
+            V2::new(0.5, 2.0),
+            V2::new(1.5, 2.9),
+            V2::new(2.6, 3.4),
+            V2::new(3.8, 3.8),
+            V2::new(3.0, 2.4),
+        ];
+        assert!(!map.segment_free(path[0], path[4]) && map.segment_free(path[0], path[3]));
+        let short = shortcut(&path, &map);
+        assert_eq!(short.last(), Some(&V2::new(3.0, 2.4)));
+        assert!(!short.contains(&V2::new(3.8, 3.8)), "{short:?}");
+        assert_eq!(map.first_blocked_segment(&short), None);
     }
 
     #[test]
