@@ -576,6 +576,22 @@ pub fn run_to_completion(config: &str, out: &Path, extra: &[&str]) -> SwarmOutco
     outcome
 }
 
+/// The shipped configuration `config` (relative to the workspace) with `edit` applied, written into `dir` under its
+/// own file name, its `supervisors="models"` pointed at the `models` folder beside it by absolute path; returns the
+/// new file's path.
+pub fn edited_config(dir: &Path, config: &str, edit: impl Fn(String) -> String) -> String {
+    let shipped = workspace_file(config);
+    let text = std::fs::read_to_string(&shipped).unwrap_or_else(|e| panic!("{config}: {e}"));
+    let models = shipped.with_file_name("models");
+    let text = text.replace(
+        "supervisors=\"models\"",
+        &format!("supervisors=\"{}\"", models.display()),
+    );
+    let path = dir.join(shipped.file_name().expect("a file name"));
+    std::fs::write(&path, edit(text)).expect("write the configuration");
+    path.display().to_string()
+}
+
 /// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.
 pub fn assert_same_records(a: &Path, b: &Path, files: &[&str]) {
     for file in files {

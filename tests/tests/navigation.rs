@@ -4,26 +4,13 @@
 
 use std::path::Path;
 
-use swarm_system_tests::{assert_same_records, run_to_completion, swarm, workspace_file};
+use swarm_system_tests::{assert_same_records, edited_config, run_to_completion, swarm};
 
 const CASE1: &str = "configs/navigation/case1.argos";
 
 fn summary(out: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
     serde_json::from_str(&text).expect("summary.json is JSON")
-}
-
-/// Case 1 as shipped, with `edit` applied to its text, written to `dir` (the models by absolute path).
-fn case1_with(dir: &Path, edit: impl Fn(String) -> String) -> String {
-    let text = std::fs::read_to_string(workspace_file(CASE1)).expect("case 1");
-    let models = workspace_file("configs/navigation/models");
-    let text = text.replace(
-        "supervisors=\"models\"",
-        &format!("supervisors=\"{}\"", models.display()),
-    );
-    let path = dir.join("case1.argos");
-    std::fs::write(&path, edit(text)).expect("write the configuration");
-    path.display().to_string()
 }
 
 /// `(x, y)` of every robot in `tick`'s rows of `trajectory.csv`.
@@ -79,7 +66,7 @@ fn eight_robots_cross_the_obstacle_rows_and_every_one_arrives_the_same_way_for_a
 #[test]
 fn without_the_coordinator_robots_hold_still_and_they_finish_once_it_is_back() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let config = case1_with(dir.path(), |text| {
+    let config = edited_config(dir.path(), CASE1, |text| {
         text.replace(
             "</argos-configuration>",
             "<faults><kill robots=\"8\" tick=\"200\" />\
@@ -162,7 +149,9 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
             "`goals` lists 2 points for 8 robots",
         ),
     ] {
-        let config = case1_with(dir.path(), |text| text.replace("radius=\"4.5\"", edit));
+        let config = edited_config(dir.path(), CASE1, |text| {
+            text.replace("radius=\"4.5\"", edit)
+        });
         let run = dir.path().join("run").display().to_string();
         let outcome = swarm(&["run", &config, "--out", &run, "--overwrite"]);
         assert!(!outcome.output.status.success(), "{edit} was accepted");
@@ -176,7 +165,7 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
             "{edit}: no `{expected}` in\n{stderr}"
         );
     }
-    let config = case1_with(dir.path(), |text| {
+    let config = edited_config(dir.path(), CASE1, |text| {
         text.replace("layout=\"circle\"", "layout=\"spiral\"")
     });
     let run = dir.path().join("run").display().to_string();

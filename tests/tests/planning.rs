@@ -5,7 +5,9 @@
 
 use std::path::Path;
 
-use swarm_system_tests::{assert_same_records, run_to_completion, swarm, workspace_file};
+use swarm_system_tests::{
+    assert_same_records, edited_config, run_to_completion, swarm, workspace_file,
+};
 
 const HIDDEN: &str = "configs/planning/hidden.argos";
 const ROBOT_RADIUS: f64 = 0.105;
@@ -14,19 +16,6 @@ fn metrics(out: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
     let summary: serde_json::Value = serde_json::from_str(&text).expect("summary.json is JSON");
     summary["metrics"].clone()
-}
-
-/// The shipped configuration with `edit` applied, written to `dir` (the models by absolute path).
-fn hidden_with(dir: &Path, edit: impl Fn(String) -> String) -> String {
-    let text = std::fs::read_to_string(workspace_file(HIDDEN)).expect("the configuration");
-    let models = workspace_file("configs/planning/models");
-    let text = text.replace(
-        "supervisors=\"models\"",
-        &format!("supervisors=\"{}\"", models.display()),
-    );
-    let path = dir.join("hidden.argos");
-    std::fs::write(&path, edit(text)).expect("write the configuration");
-    path.display().to_string()
 }
 
 /// Every cylinder of the configuration at `path`: id, centre and radius.
@@ -137,7 +126,7 @@ fn a_gsa_robot_finds_the_hidden_cylinders_replans_and_arrives_the_same_way_for_a
 #[test]
 fn with_every_cylinder_on_its_map_a_theta_star_robot_never_replans_and_drives_the_optimum() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let config = hidden_with(dir.path(), |text| {
+    let config = edited_config(dir.path(), HIDDEN, |text| {
         text.replace(" hidden=\"h*\"", "")
             .replace("planner=\"gsa\"", "planner=\"theta_star\"")
     });
@@ -182,7 +171,7 @@ fn bad_planning_settings_are_refused_with_their_place() {
             "the goal (8.5, 8.5) of robot `robot` cannot be reached from its start (1, 1): obstacles wall it off",
         ),
     ] {
-        let config = hidden_with(dir.path(), |text| {
+        let config = edited_config(dir.path(), HIDDEN, |text| {
             text.replace(from, to)
                 .replace("  </arena>", &format!("{}  </arena>", ring_round(8.5, 8.5)))
         });

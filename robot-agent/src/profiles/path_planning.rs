@@ -111,17 +111,14 @@ impl PathPlanner {
     /// The map a point robot plans in: the known and found obstacles grown by the body and the margin, the box
     /// shrunk by the body.
     fn planning_map(&self, bounds: Bounds, radius: f32) -> Map {
-        Map {
-            bounds: bounds.inset(radius),
-            discs: self
-                .known
-                .items
-                .iter()
-                .chain(self.found.obstacles())
-                .copied()
-                .collect(),
-        }
-        .grown(radius + self.margin)
+        let discs: Vec<Disc> = self
+            .known
+            .items
+            .iter()
+            .chain(self.found.obstacles())
+            .copied()
+            .collect();
+        Map::for_body(bounds, &discs, radius, self.margin)
     }
 
     /// Reads the range finder; returns whether an obstacle was found or grew.
@@ -147,11 +144,7 @@ impl PathPlanner {
     /// Whether the rest of the path, from the robot on, crosses a found obstacle (grown like the planner's).
     /// An obstacle the robot already stands in may be left, as the planner allows ([`Map::opened_at`]).
     fn rest_blocked(&self, here: V2, radius: f32, bounds: Bounds) -> bool {
-        let found = Map {
-            bounds,
-            discs: self.found.obstacles().to_vec(),
-        }
-        .grown(radius + self.margin);
+        let found = Map::for_body(bounds, self.found.obstacles(), radius, self.margin);
         let rest = &self.path[self.progress.min(self.path.len())..];
         let blocked = |a: V2, b: V2| found.discs.iter().any(|d| segment_hits(a, b, d));
         rest.first().is_some_and(|&next| {

@@ -37,6 +37,7 @@ use swarm_contract::messages::ActuatorCommand;
 use swarm_navigation::V2;
 use swarm_navigation::apf::Disc;
 use swarm_navigation::planning::Bounds;
+use swarm_navigation::planning::theta_star::SearchError;
 use swarm_navigation::wire::{self, Letter, PAYLOAD, PlanReport, Task};
 
 use crate::arena::Arena;
@@ -48,7 +49,7 @@ use crate::loop_functions::{LoopFunctions, LoopFunctionsParams};
 use crate::rng::{Purpose, stream};
 
 mod planning;
-use planning::{Totals, TripFigures, optimum, walled_off};
+use planning::{Totals, TripFigures, reference};
 
 /// The label under which the configuration selects these loop functions.
 pub const LABEL: &str = "navigation_loop_functions";
@@ -83,6 +84,8 @@ struct Trip {
     goal: V2,
     /// Where the robot was when the task started.
     start: V2,
+    /// The reference optimum of the task when its goal was drawn (continuous tasking), else worked out on arrival.
+    optimum: Option<f32>,
     started: u64,
     path: f64,
     last: Option<V2>,
@@ -139,6 +142,14 @@ pub struct Navigation {
     ticks_per_second: u32,
     location: String,
     output: String,
+}
+
+/// Whether entity id `name` matches `pattern`: the id itself, or `prefix*` for every id starting with `prefix`.
+fn id_matches(pattern: &str, name: &str) -> bool {
+    match pattern.strip_suffix('*') {
+        Some(prefix) => name.starts_with(prefix),
+        None => pattern == name,
+    }
 }
 
 fn v(p: (f64, f64)) -> V2 {
@@ -251,12 +262,25 @@ impl Navigation {
         None
     }
 
-    /// A random goal as [`Navigation::draw`] gives, that obstacles do not wall off from `start`.
-    fn draw_reachable(&mut self, start: V2, radius: f32, taken: &[V2], apart: f32) -> Option<V2> {
+    /// The reference search from `start` to `goal` for a robot of `radius` on the whole map.
+    fn reference(&self, start: V2, goal: V2, radius: f32) -> Result<f32, SearchError> {
+        reference(start, goal, &self.map, self.bounds, radius)
+    }
+
+    /// A random goal as [`Navigation::draw`] gives, that obstacles do not wall off from `start`, with the
+    /// reference optimum the search that decided it found (if it could tell).
+    fn draw_reachable(
+        &mut self,
+        start: V2,
+        radius: f32,
+        taken: &[V2],
+        apart: f32,
+    ) -> Option<(V2, Option<f32>)> {
         for _ in 0..REACHABLE_ATTEMPTS {
             let goal = self.draw(radius, taken, apart)?;
-            if !walled_off(start, goal, &self.map, self.bounds, radius) {
-                return Some(goal);
+            match self.reference(start, goal, radius) {
+                Err(SearchError::Unreachable) => continue,
+                found => return Some((goal, found.ok())),
             }
         }
         None
@@ -337,6 +361,7 @@ impl Navigation {
                     let apart = 2.0 * radius + 2.0 * self.clearance;
                     let start = to_v2(robot.position);
                     self.draw_reachable(start, radius, &goals, apart)
+                        .map(|(goal, _)| goal)
                         .ok_or_else(|| {
                             self.error(format!(
                                 "no free goal for robot `{}` in the area that it can reach",
@@ -392,7 +417,7 @@ impl Navigation {
             )));
         }
         let start = to_v2(r.position);
-        if walled_off(start, goal, &self.map, self.bounds, radius) {
+        if self.reference(start, goal, radius) == Err(SearchError::Unreachable) {
             return Err(self.error(format!(
                 "the goal ({}, {}) of robot `{}` cannot be reached from its start ({}, {}): obstacles wall it off",
                 goal.x, goal.y, r.name, start.x, start.y
@@ -421,10 +446,7 @@ impl Navigation {
     }
 
     fn is_hidden(&self, name: &str) -> bool {
-        self.hidden.iter().any(|h| match h.strip_suffix('*') {
-            Some(prefix) => name.starts_with(prefix),
-            None => h == name,
-        })
+        self.hidden.iter().any(|h| id_matches(h, name))
     }
 
     fn error(&self, message: String) -> WorldError {
@@ -440,15 +462,13 @@ impl Navigation {
         let trip = &self.trips[robot];
         let figures = TripFigures {
             // The trip ends on entering the goal's tolerance, so the reference ends there too.
-            optimum: optimum(trip.start, trip.goal, &self.map, self.bounds, radius)
+            optimum: trip
+                .optimum
+                .or_else(|| self.reference(trip.start, trip.goal, radius).ok())
                 .map(|o| (o - self.tolerance).max(0.0)),
-            known_optimum: trip.report.and(optimum(
-                trip.start,
-                trip.goal,
-                &self.known,
-                self.bounds,
-                radius,
-            )),
+            known_optimum: trip
+                .report
+                .and(reference(trip.start, trip.goal, &self.known, self.bounds, radius).ok()),
             driven: trip.path,
             report: trip.report,
         };
@@ -492,9 +512,10 @@ impl Navigation {
         let next = self.draw_reachable(here, radius, &[], 0.0);
         let trip = &mut self.trips[robot];
         match next {
-            Some(goal) => {
+            Some((goal, optimum)) => {
                 trip.goal = goal;
                 trip.start = here;
+                trip.optimum = optimum;
                 trip.report = None;
                 trip.seq += 1;
                 trip.started = self.tick;
@@ -541,12 +562,11 @@ impl LoopFunctions for Navigation {
             .filter(|o| matches!(o.placed.shape, Shape::Disc { .. }))
             .map(|o| o.name.as_str())
             .collect();
-        if let Some(unknown) = self.hidden.iter().find(|h| {
-            let prefix = h.strip_suffix('*');
-            !cylinders
-                .iter()
-                .any(|c| prefix.map_or(*c == h.as_str(), |p| c.starts_with(p)))
-        }) {
+        if let Some(unknown) = self
+            .hidden
+            .iter()
+            .find(|h| !cylinders.iter().any(|c| id_matches(h, c)))
+        {
             return Err(self.error(format!(
                 "`hidden` names `{unknown}`, which matches no cylinder of the arena"
             )));

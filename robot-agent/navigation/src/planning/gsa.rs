@@ -10,7 +10,7 @@
 
 use rand::Rng;
 
-use super::map::{EndpointError, Map, path_length, segment_hits};
+use super::map::{EndpointError, Map, path_length};
 use crate::V2;
 
 /// The planner's parameters. Defaults: docs/planning.md.
@@ -297,11 +297,6 @@ impl Swarm {
     }
 }
 
-/// Whether a trajectory touches no obstacle (step 9).
-fn collision_free(trajectory: &[V2], map: &Map) -> bool {
-    trajectory.windows(2).all(|w| map.segment_free(w[0], w[1]))
-}
-
 /// Plans a path from `start` to `goal` on `map` (obstacles already grown by the robot's size) with GSA, on the
 /// map opened at the start ([`Map::opened_at`]: a robot inside an obstacle's safety margin may leave it). The
 /// result is a pure function of the inputs and `rng`'s state.
@@ -332,7 +327,8 @@ pub fn plan(
     let mut free = 0;
     let mut best: Option<(f32, usize)> = None;
     for (i, trajectory) in swarm.trajectory.iter_mut().enumerate() {
-        if !collision_free(trajectory, map) {
+        // Step 9, collision filtering.
+        if map.first_blocked_segment(trajectory).is_some() {
             continue;
         }
         free += 1;
@@ -341,7 +337,7 @@ pub fn plan(
         }
         // The goal itself ends the path; the last step to it must be free too.
         let last = *trajectory.last().unwrap_or(&start);
-        if !map.discs.iter().any(|d| segment_hits(last, goal, d)) {
+        if map.segment_free(last, goal) {
             trajectory.push(goal);
             let length = path_length(trajectory);
             if best.is_none_or(|(l, _)| length < l) {
@@ -513,8 +509,14 @@ mod tests {
         let (found, _) = plans(start, V2::new(5.0, 1.0), &map, &GsaParams::default(), 5);
         assert!(!found.is_empty());
         let opened = map.opened_at(start);
-        assert!(collision_free(&[start, V2::new(5.0, 3.0)], &opened));
-        assert!(!collision_free(&[start, V2::new(5.0, 4.2)], &opened));
+        assert_eq!(
+            opened.first_blocked_segment(&[start, V2::new(5.0, 3.0)]),
+            None
+        );
+        assert_eq!(
+            opened.first_blocked_segment(&[start, V2::new(5.0, 4.2)]),
+            Some(0)
+        );
     }
 
     proptest::proptest! {

@@ -115,6 +115,16 @@ impl Map {
         }
     }
 
+    /// The map a disc robot of `radius` moves in as a point, among `discs` in `bounds`: the box shrunk by the
+    /// radius (the centre keeps that far from the edges) and every disc grown by the radius plus `margin`.
+    pub fn for_body(bounds: Bounds, discs: &[Disc], radius: f32, margin: f32) -> Map {
+        Map {
+            bounds: bounds.inset(radius),
+            discs: discs.to_vec(),
+        }
+        .grown(radius + margin)
+    }
+
     /// The same map with every disc's radius grown by `by` metres.
     pub fn grown(&self, by: f32) -> Map {
         self.with_radii(|d| d.radius + by)

@@ -12,29 +12,18 @@ use swarm_navigation::wire::PlanReport;
 /// Grid of the reference search (m).
 pub const REFERENCE_RESOLUTION: f32 = 0.05;
 
-/// The map a robot of `radius` among `discs` in `bounds` moves in, as a point: discs grown by the radius, and
-/// the box shrunk by it (the centre keeps one radius from the arena's edges).
-fn robot_map(discs: &[Disc], bounds: Bounds, radius: f32) -> Map {
-    Map {
-        bounds: bounds.inset(radius),
-        discs: discs.to_vec(),
-    }
-    .grown(radius)
-}
-
-/// The reference optimum from `start` to `goal` for a robot of `radius` among `discs` in `bounds`, or `None`
-/// when the search finds no way (a goal walled in) or cannot search (a map too large for its grid).
-pub fn optimum(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> Option<f32> {
-    let map = robot_map(discs, bounds, radius);
-    shortest_length(map.bounds.clamp(start), goal, &map, REFERENCE_RESOLUTION).ok()
-}
-
-/// Whether obstacles wall `goal` off from `start` for a robot of `radius` (`false` when the search cannot
-/// tell: a map too large for its grid).
-pub fn walled_off(start: V2, goal: V2, discs: &[Disc], bounds: Bounds, radius: f32) -> bool {
-    let map = robot_map(discs, bounds, radius);
+/// The reference search from `start` to `goal` for a robot of `radius` among `discs` in `bounds`: the length of
+/// the shortest way, or why there is none (`SearchError::Unreachable` for a goal walled off; other errors when the
+/// search cannot tell, e.g. a map too large for its grid).
+pub fn reference(
+    start: V2,
+    goal: V2,
+    discs: &[Disc],
+    bounds: Bounds,
+    radius: f32,
+) -> Result<f32, SearchError> {
+    let map = Map::for_body(bounds, discs, radius, 0.0);
     shortest_length(map.bounds.clamp(start), goal, &map, REFERENCE_RESOLUTION)
-        == Err(SearchError::Unreachable)
 }
 
 /// One finished trip's planning figures.
@@ -125,21 +114,14 @@ mod tests {
             min: V2::ZERO,
             max: V2::new(10.0, 10.0),
         };
-        let free = optimum(V2::new(1.0, 5.0), V2::new(9.0, 5.0), &[], bounds, 0.1).unwrap();
+        let free = reference(V2::new(1.0, 5.0), V2::new(9.0, 5.0), &[], bounds, 0.1).unwrap();
         assert!((free - 8.0).abs() < 1e-4);
         let disc = Disc {
             centre: V2::new(5.0, 5.0),
             radius: 0.9,
         };
-        let round = optimum(V2::new(1.0, 5.0), V2::new(9.0, 5.0), &[disc], bounds, 0.1).unwrap();
+        let round = reference(V2::new(1.0, 5.0), V2::new(9.0, 5.0), &[disc], bounds, 0.1).unwrap();
         assert!(round > 8.2 && round < 8.6, "{round}");
-        assert!(!walled_off(
-            V2::new(1.0, 5.0),
-            V2::new(9.0, 5.0),
-            &[disc],
-            bounds,
-            0.1
-        ));
         // A ring of discs round the goal.
         let ring: Vec<Disc> = (0..8)
             .map(|k| Disc {
@@ -148,13 +130,10 @@ mod tests {
                 radius: 0.3,
             })
             .collect();
-        assert!(walled_off(
-            V2::new(1.0, 5.0),
-            V2::new(5.0, 5.0),
-            &ring,
-            bounds,
-            0.1
-        ));
+        assert_eq!(
+            reference(V2::new(1.0, 5.0), V2::new(5.0, 5.0), &ring, bounds, 0.1),
+            Err(SearchError::Unreachable)
+        );
     }
 
     #[test]
