@@ -3,6 +3,7 @@
 
 pub mod disc_wander;
 pub mod epuck_obstacleavoidance;
+pub mod exploration_coordinator;
 pub mod footbot;
 pub mod footbot_diffusion;
 pub mod footbot_flocking;
@@ -20,6 +21,7 @@ use thiserror::Error;
 use crate::params::{ParamError, Params};
 use disc_wander::DiscWander;
 use epuck_obstacleavoidance::EpuckObstacleAvoidance;
+use exploration_coordinator::ExplorationCoordinator;
 use footbot_diffusion::FootbotDiffusion;
 use footbot_flocking::FootbotFlocking;
 use footbot_foraging::FootbotForaging;
@@ -79,6 +81,9 @@ const NATIVE: &[(&str, BuildFn)] = &[
     }),
     (MailProbe::NAME, |p| {
         Ok(Box::new(MailProbe::from_params(p)?))
+    }),
+    (ExplorationCoordinator::NAME, |p| {
+        Ok(Box::new(ExplorationCoordinator::from_params(p)?))
     }),
     (NavigationCoordinator::NAME, |p| {
         Ok(Box::new(NavigationCoordinator::from_params(p)?))

@@ -4,6 +4,7 @@
 
 pub mod aggregation;
 mod assembly;
+pub mod exploration;
 pub mod foraging;
 pub mod navigation;
 pub mod obstacle_avoidance;
@@ -24,6 +25,7 @@ use crate::params::{ParamError, Params};
 use crate::profile::Profile;
 
 use aggregation::Aggregation;
+use exploration::Explorer;
 use foraging::Forager;
 use navigation::Navigator;
 use obstacle_avoidance::{ObstacleAvoidance, ObstacleAvoidanceSct};
@@ -86,6 +88,7 @@ const PROFILES: &[(&str, BindFn)] = &[
     (Phototaxis::NAME, bind_boxed::<Phototaxis>),
     (Navigator::NAME, bind_boxed::<Navigator>),
     (PathPlanner::NAME, bind_boxed::<PathPlanner>),
+    (Explorer::NAME, bind_boxed::<Explorer>),
 ];
 
 /// Why a profile could not be set up.
@@ -173,7 +176,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning, exploration)"
         );
     }
 

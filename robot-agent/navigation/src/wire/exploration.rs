@@ -4,7 +4,7 @@
 //!
 //! | tag | letter | from -> to |
 //! |---|---|---|
-//! | 16 | [`Setup`]: the robot's type, the tick rate, how close counts as at a task | task server -> robot |
+//! | 16 | [`Setup`]: the robot's type, the tick rate, how close counts as at a task, its rays' reach | task server -> robot |
 //! | 17 | [`Found`]: a task, as the robot sensed it or as a robot reports it | task server -> robot; robot -> coordinator |
 //! | 18 | [`Status`]: type, mode, task, position, distance driven to tasks | robot -> coordinator and task server |
 //! | 19 | [`Assign`]: go and do a task | coordinator -> robot |
@@ -32,7 +32,7 @@ const DONE: u8 = 21;
 const RECALL: u8 = 22;
 const REGION: u8 = 23;
 const ALLOCATION: u8 = 24;
-const SETUP_LEN: usize = 1 + 1 + 4 + 4;
+const SETUP_LEN: usize = 1 + 1 + 4 + 4 + 4;
 const FOUND_LEN: usize = 1 + 2 + 2 * 4 + 1 + 4 + 4 + 4 + 1;
 const STATUS_LEN: usize = 1 + 1 + 1 + 2 + 2 * 4 + 4;
 const ASSIGN_LEN: usize = 1 + 2 + 2 * 4 + 4;
@@ -55,6 +55,8 @@ pub struct Setup {
     pub ticks_per_second: u32,
     /// A robot whose centre is this close to a task's position is at the task (m).
     pub reach: f32,
+    /// The reach of the robot's range rays (m): a reading of infinity saw free space this far.
+    pub sensor_range: f32,
 }
 
 /// A task as sensed or reported.
@@ -247,7 +249,8 @@ pub fn encode_setup(setup: &Setup, out: &mut [u8; PAYLOAD]) -> usize {
     let mut w = Writer { out, at: 0 };
     w.bytes(&[SETUP, kind_byte(setup.kind)])
         .bytes(&setup.ticks_per_second.to_le_bytes())
-        .f32(setup.reach);
+        .f32(setup.reach)
+        .f32(setup.sensor_range);
     w.at
 }
 
@@ -345,7 +348,9 @@ pub fn encode_allocation(allocation: &Allocation, out: &mut [u8; PAYLOAD]) -> us
 
 /// Whether `payload` is an exploration message (its tag is one of this module's), whatever else is wrong with it.
 pub fn is_exploration(payload: &[u8]) -> bool {
-    payload.first().is_some_and(|t| (SETUP..=ALLOCATION).contains(t))
+    payload
+        .first()
+        .is_some_and(|t| (SETUP..=ALLOCATION).contains(t))
 }
 
 /// Decodes an exploration payload.
@@ -372,6 +377,7 @@ pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
                 kind: kind(r.u8())?,
                 ticks_per_second: r.u32(),
                 reach: r.positive()?,
+                sensor_range: r.positive()?,
             };
             if setup.ticks_per_second == 0 {
                 return Err(WireError::BadNumber);
@@ -406,7 +412,8 @@ pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
                 position: r.v2()?,
                 to_tasks: r.f32()?,
             };
-            let task_fits_mode = status.task.is_some() == matches!(mode, Mode::Travel | Mode::Execute);
+            let task_fits_mode =
+                status.task.is_some() == matches!(mode, Mode::Travel | Mode::Execute);
             if !task_fits_mode || status.to_tasks < 0.0 {
                 return Err(WireError::BadNumber);
             }
@@ -493,6 +500,7 @@ mod tests {
             kind: Kind::Two,
             ticks_per_second: 10,
             reach: 0.3,
+            sensor_range: 1.5,
         };
         let len = encode_setup(&setup, &mut out);
         assert_eq!(decode(&out[..len]), Ok(Letter::Setup(setup)));
@@ -549,7 +557,10 @@ mod tests {
         let Ok(Letter::Region(region)) = decode(&out[..len]) else {
             panic!("not a region");
         };
-        assert_eq!((region.tick, region.centre, region.heading), (99, V2::new(4.0, 4.0), 0.5));
+        assert_eq!(
+            (region.tick, region.centre, region.heading),
+            (99, V2::new(4.0, 4.0), 0.5)
+        );
         assert_eq!(region.rays().collect::<Vec<_>>(), rays);
     }
 
@@ -581,6 +592,7 @@ mod tests {
                 kind: Kind::One,
                 ticks_per_second: 10,
                 reach: 0.3,
+                sensor_range: 1.0,
             },
             &mut out,
         );
@@ -592,7 +604,13 @@ mod tests {
             decode(&out[..len]),
             Err(WireError::Length { tag: REGION, len })
         );
-        assert_eq!(decode(&[RECALL, 0]), Err(WireError::Length { tag: RECALL, len: 2 }));
+        assert_eq!(
+            decode(&[RECALL, 0]),
+            Err(WireError::Length {
+                tag: RECALL,
+                len: 2
+            })
+        );
         assert!(is_exploration(&[RECALL]) && !is_exploration(&[3]) && !is_exploration(&[]));
     }
 
