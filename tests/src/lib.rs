@@ -592,6 +592,15 @@ pub fn edited_config(dir: &Path, config: &str, edit: impl Fn(String) -> String) 
     path.display().to_string()
 }
 
+/// The line of the `<loop_functions>` element of the configuration at `path`, where task errors point.
+pub fn loop_functions_line(path: &str) -> usize {
+    let text = std::fs::read_to_string(path).expect("the configuration");
+    1 + text
+        .lines()
+        .position(|l| l.contains("<loop_functions"))
+        .expect("a <loop_functions> element")
+}
+
 /// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.
 pub fn assert_same_records(a: &Path, b: &Path, files: &[&str]) {
     for file in files {

@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use swarm_system_tests::{assert_same_records, edited_config, run_to_completion, swarm};
+use swarm_system_tests::{
+    assert_same_records, edited_config, loop_functions_line, run_to_completion, swarm,
+};
 
 const CASE1: &str = "configs/navigation/case1.argos";
 
@@ -175,13 +177,4 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
             .stderr()
             .contains("<navigation layout=\"spiral\">: must be one of circle, random, as_placed")
     );
-}
-
-/// The line of the `<loop_functions>` element of the configuration at `path`, where task errors point.
-fn loop_functions_line(path: &str) -> usize {
-    let text = std::fs::read_to_string(path).expect("the configuration");
-    1 + text
-        .lines()
-        .position(|l| l.contains("<loop_functions"))
-        .expect("a <loop_functions> element")
 }
