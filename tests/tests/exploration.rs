@@ -184,7 +184,8 @@ fn impossible_problems_are_refused_with_the_place_in_the_configuration() {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    let cases: [(Box<dyn Fn(String) -> String>, &str); 3] = [
+    type Edit = Box<dyn Fn(String) -> String>;
+    let cases: [(Edit, &str); 3] = [
         (
             Box::new(one_scout),
             "task 1 at (4.8, 4.8) is of type 2, which no team of this swarm can do",

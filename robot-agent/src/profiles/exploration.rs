@@ -118,12 +118,11 @@ impl Explorer {
     fn learn(&mut self, found: Found) {
         let room = self.known.len() < self.known.capacity();
         match self.known.iter_mut().find(|f| f.task == found.task) {
-            Some(known) => {
-                if found.done && !known.done {
-                    known.done = true;
-                    self.to_coordinator.push_back(Letter::Done(found.task));
-                }
+            Some(known) if found.done && !known.done => {
+                known.done = true;
+                self.to_coordinator.push_back(Letter::Done(found.task));
             }
+            Some(_) => {}
             None if room => {
                 self.known.push(found);
                 self.to_coordinator.push_back(Letter::Found(found));

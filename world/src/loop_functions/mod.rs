@@ -5,6 +5,7 @@
 pub mod aggregation;
 pub mod argos_foraging;
 pub mod default;
+pub mod exploration;
 pub mod foraging;
 pub mod navigation;
 pub mod obstacle_avoidance;
@@ -143,7 +144,7 @@ pub struct LoopFunctionsRegistry {
 impl Default for LoopFunctionsRegistry {
     /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
     /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`,
-    /// `phototaxis_loop_functions`, `navigation_loop_functions`.
+    /// `phototaxis_loop_functions`, `navigation_loop_functions`, `exploration_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -164,6 +165,7 @@ impl Default for LoopFunctionsRegistry {
         );
         registry.register(phototaxis::LABEL, phototaxis::Phototaxis::factory);
         registry.register(navigation::LABEL, navigation::Navigation::factory);
+        registry.register(exploration::LABEL, exploration::Exploration::factory);
         registry
     }
 }

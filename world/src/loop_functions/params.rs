@@ -141,6 +141,28 @@ impl<'a> ParamReader<'a> {
         })
     }
 
+    /// The text of attribute `name`, which the element must have.
+    pub fn required(&self, name: &str) -> Result<&str, WorldError> {
+        self.raw(name)
+            .map(String::as_str)
+            .ok_or_else(|| WorldError::Invalid {
+                location: self.params.location.clone(),
+                message: format!("<{}> needs the attribute '{name}'", self.element),
+            })
+    }
+
+    /// Attribute `name` as a number > 0, or `None` when it is absent or the word `word` (a named alternative to
+    /// a number, e.g. `discovery="sensor"`).
+    pub fn positive_or_word(&self, name: &str, word: &str) -> Result<Option<f64>, WorldError> {
+        match self.raw(name) {
+            Some(raw) if raw.trim() != word => match raw.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(Some(v)),
+                _ => Err(self.invalid(name, raw, &format!("`{word}` or a number > 0"))),
+            },
+            _ => Ok(None),
+        }
+    }
+
     /// The text of attribute `name` of this element, if given.
     fn raw(&self, name: &str) -> Option<&String> {
         self.params
@@ -204,6 +226,28 @@ mod tests {
             r.u64_at_least("window", 5, 1).unwrap_err().to_string(),
             "e.argos:3:5: <task window=\"0\">: must be a whole number >= 1"
         );
+    }
+
+    #[test]
+    fn a_required_attribute_and_a_word_for_a_number() {
+        let p = params(&[("task.radius", "sensor"), ("task.cell", "-1")]);
+        let r = ParamReader::new(&p, "task", &["radius", "cell", "list"]).unwrap();
+        assert_eq!(
+            r.required("list").unwrap_err().to_string(),
+            "e.argos:3:5: <task> needs the attribute 'list'"
+        );
+        assert_eq!(r.required("radius").unwrap(), "sensor");
+        assert_eq!(r.positive_or_word("radius", "sensor").unwrap(), None);
+        assert_eq!(r.positive_or_word("list", "sensor").unwrap(), None);
+        assert_eq!(
+            r.positive_or_word("cell", "sensor")
+                .unwrap_err()
+                .to_string(),
+            "e.argos:3:5: <task cell=\"-1\">: must be `sensor` or a number > 0"
+        );
+        let p = params(&[("task.radius", " 0.5 ")]);
+        let r = ParamReader::new(&p, "task", &["radius"]).unwrap();
+        assert_eq!(r.positive_or_word("radius", "sensor").unwrap(), Some(0.5));
     }
 
     #[test]
