@@ -513,3 +513,130 @@ impl Profile for Explorer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use swarm_allocation::Kind;
+    use swarm_contract::mail::Mail;
+
+    use super::*;
+
+    const ME: u32 = 1;
+    const COORDINATOR: u32 = 5;
+
+    fn inbox(letters: &[(u32, Vec<u8>)]) -> Mailbox {
+        let mut inbox = Mailbox::empty(ME);
+        for (from, payload) in letters {
+            inbox
+                .push(Mail::new(*from, Address::To(ME), payload).unwrap())
+                .unwrap();
+        }
+        inbox
+    }
+
+    fn encoded(encode: impl FnOnce(&mut [u8; PAYLOAD]) -> usize) -> Vec<u8> {
+        let mut p = [0u8; PAYLOAD];
+        let len = encode(&mut p);
+        p[..len].to_vec()
+    }
+
+    fn setup() -> Vec<u8> {
+        let setup = Setup {
+            kind: Kind::One,
+            ticks_per_second: 10,
+            reach: 0.3,
+            sensor_range: 1.0,
+        };
+        encoded(|p| wire::encode_setup(&setup, p))
+    }
+
+    fn found(task: u16) -> Found {
+        Found {
+            task,
+            position: V2::new(2.0, 0.0),
+            kind: Kind::One,
+            value: 10.0,
+            window_end: 100,
+            decay: 10,
+            done: false,
+        }
+    }
+
+    /// What the robot sends this tick, decoded, with addresses.
+    fn sent(robot: &mut Explorer) -> Vec<(Address, Vec<u8>)> {
+        let mut outbox = Mailbox::empty(ME);
+        robot.send(&mut outbox);
+        outbox
+            .messages()
+            .iter()
+            .map(|m| (m.address(), m.payload().to_vec()))
+            .collect()
+    }
+
+    fn founds(sent: &[(Address, Vec<u8>)]) -> Vec<u16> {
+        sent.iter()
+            .filter_map(|(to, p)| match wire::decode(p) {
+                Ok(Letter::Found(f)) if *to == Address::To(COORDINATOR) => Some(f.task),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn tasks_go_to_the_coordinator_once_and_all_again_on_a_recall() {
+        let mut robot = Explorer::from_params(&Params::default()).unwrap();
+        let (t0, t1) = (found(0), found(1));
+        robot.receive(&inbox(&[
+            (FROM_WORLD, setup()),
+            (COORDINATOR, encoded(wire::encode_recall)),
+            (FROM_WORLD, encoded(|p| wire::encode_found(&t0, p))),
+            (FROM_WORLD, encoded(|p| wire::encode_found(&t1, p))),
+        ]));
+        let first = sent(&mut robot);
+        assert_eq!(founds(&first), vec![0, 1]);
+        // The heartbeat goes to the coordinator and the status to the world.
+        assert!(first.iter().any(|(to, _)| *to == Address::To(TO_WORLD)));
+        robot.receive(&inbox(&[(FROM_WORLD, encoded(|p| wire::encode_found(&t0, p)))]));
+        assert!(founds(&sent(&mut robot)).is_empty(), "a task is reported once");
+        robot.receive(&inbox(&[(COORDINATOR, encoded(wire::encode_recall))]));
+        assert_eq!(founds(&sent(&mut robot)), vec![0, 1]);
+    }
+
+    #[test]
+    fn an_assignment_is_taken_once_and_dropped_when_cancelled_or_known_done() {
+        let mut robot = Explorer::from_params(&Params::default()).unwrap();
+        let frame = SensorFrame::empty(ME);
+        let assign = |task: u16, allocation: u32| {
+            let a = Assign {
+                task,
+                position: V2::new(2.0, 0.0),
+                allocation,
+            };
+            encoded(|p| wire::encode_assign(&a, p))
+        };
+        robot.receive(&inbox(&[(FROM_WORLD, setup()), (COORDINATOR, assign(0, 1))]));
+        assert!(assigned(&robot, &frame));
+        take_task(&mut robot, &frame, &mut ActuatorCommand::idle(ME, 0));
+        assert!(!assigned(&robot, &frame) && !at_task(&robot, &frame));
+        // The same letter again (a resend) is no new assignment.
+        robot.receive(&inbox(&[(COORDINATOR, assign(0, 1))]));
+        assert!(!assigned(&robot, &frame));
+        // A cancel from someone else than the coordinator is ignored; from the coordinator it counts.
+        robot.receive(&inbox(&[(3, encoded(|p| wire::encode_cancel(0, p)))]));
+        assert!(!cancelled(&robot, &frame));
+        robot.receive(&inbox(&[(COORDINATOR, encoded(|p| wire::encode_cancel(0, p)))]));
+        assert!(cancelled(&robot, &frame));
+        // An offer of a task known to be complete is no assignment.
+        let mut robot = Explorer::from_params(&Params::default()).unwrap();
+        let done = Found {
+            done: true,
+            ..found(4)
+        };
+        robot.receive(&inbox(&[
+            (FROM_WORLD, setup()),
+            (FROM_WORLD, encoded(|p| wire::encode_found(&done, p))),
+            (COORDINATOR, assign(4, 2)),
+        ]));
+        assert!(!assigned(&robot, &frame));
+    }
+}
