@@ -592,13 +592,14 @@ pub fn edited_config(dir: &Path, config: &str, edit: impl Fn(String) -> String) 
     path.display().to_string()
 }
 
-/// The line of the `<loop_functions>` element of the configuration at `path`, where task errors point.
-pub fn loop_functions_line(path: &str) -> usize {
+/// The line of the first `<element` of the configuration at `path`, where errors about it point (task errors
+/// point at `<loop_functions`).
+pub fn element_line(path: &str, element: &str) -> usize {
     let text = std::fs::read_to_string(path).expect("the configuration");
     1 + text
         .lines()
-        .position(|l| l.contains("<loop_functions"))
-        .expect("a <loop_functions> element")
+        .position(|l| l.contains(&format!("<{element}")))
+        .unwrap_or_else(|| panic!("no <{element}> element in {path}"))
 }
 
 /// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.

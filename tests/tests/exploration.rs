@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, loop_functions_line, run_to_completion, swarm,
+    assert_same_records, edited_config, element_line, run_to_completion, swarm,
 };
 
 const SMALL: &str = "configs/exploration/small.argos";
@@ -99,7 +99,7 @@ fn a_small_problem_is_explored_and_every_task_done_the_same_way_for_a_seed() {
 }
 
 #[test]
-fn a_robot_killed_on_its_way_loses_its_task_to_the_survivors() {
+fn a_robot_killed_on_its_way_loses_its_task_to_the_survivors_the_same_way_every_time() {
     let dir = tempfile::tempdir().expect("tempdir");
     let baseline = dir.path().join("baseline");
     run_to_completion(SMALL, &baseline, &[]);
@@ -110,6 +110,19 @@ fn a_robot_killed_on_its_way_loses_its_task_to_the_survivors() {
     let config = with_faults(dir.path(), &faults);
     let out = dir.path().join("killed");
     run_to_completion(&config, &out, &[]);
+    // The same seed and fault schedule give the same run.
+    let again = dir.path().join("again");
+    run_to_completion(&config, &again, &[]);
+    assert_same_records(
+        &out,
+        &again,
+        &[
+            "trajectory.csv",
+            "events.csv",
+            "messages.csv",
+            "exploration.csv",
+        ],
+    );
     assert_eq!(events(&out, "take_task")[0], (taken, robot));
     assert!(
         !events(&out, "at_task")
@@ -185,25 +198,27 @@ fn impossible_problems_are_refused_with_the_place_in_the_configuration() {
             .join("\n")
     };
     type Edit = Box<dyn Fn(String) -> String>;
-    let cases: [(Edit, &str); 3] = [
+    let cases: [(Edit, &str, &str); 3] = [
         (
             Box::new(one_scout),
+            "loop_functions",
             "task 1 at (4.8, 4.8) is of type 2, which no team of this swarm can do",
         ),
         (
             Box::new(|text: String| text.replace("4.6,1.3,1,30,300", "3.6,3.4,1,30,300")),
+            "loop_functions",
             "`o1`",
         ),
-        (Box::new(no_robots), "at least one robot"),
+        (Box::new(no_robots), "arena", "the arena has no robot"),
     ];
-    for (edit, expected) in cases {
+    for (edit, element, expected) in cases {
         let config = edited_config(dir.path(), SMALL, edit);
         let run = dir.path().join("run").display().to_string();
         let outcome = swarm(&["run", &config, "--out", &run, "--overwrite"]);
         assert!(!outcome.output.status.success(), "{expected}: accepted");
         let stderr = outcome.stderr();
         assert!(
-            stderr.contains(&format!("{config}:{}:", loop_functions_line(&config))),
+            stderr.contains(&format!("{config}:{}:", element_line(&config, element))),
             "{expected}: no location in\n{stderr}"
         );
         assert!(stderr.contains(expected), "no `{expected}` in\n{stderr}");

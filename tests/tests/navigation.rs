@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, loop_functions_line, run_to_completion, swarm,
+    assert_same_records, edited_config, element_line, run_to_completion, swarm,
 };
 
 const CASE1: &str = "configs/navigation/case1.argos";
@@ -159,7 +159,10 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
         assert!(!outcome.output.status.success(), "{edit} was accepted");
         let stderr = outcome.stderr();
         assert!(
-            stderr.contains(&format!("{config}:{}:", loop_functions_line(&config))),
+            stderr.contains(&format!(
+                "{config}:{}:",
+                element_line(&config, "loop_functions")
+            )),
             "{edit}: no location in\n{stderr}"
         );
         assert!(

@@ -596,8 +596,14 @@ mod tests {
         assert_eq!(founds(&first), vec![0, 1]);
         // The heartbeat goes to the coordinator and the status to the world.
         assert!(first.iter().any(|(to, _)| *to == Address::To(TO_WORLD)));
-        robot.receive(&inbox(&[(FROM_WORLD, encoded(|p| wire::encode_found(&t0, p)))]));
-        assert!(founds(&sent(&mut robot)).is_empty(), "a task is reported once");
+        robot.receive(&inbox(&[(
+            FROM_WORLD,
+            encoded(|p| wire::encode_found(&t0, p)),
+        )]));
+        assert!(
+            founds(&sent(&mut robot)).is_empty(),
+            "a task is reported once"
+        );
         robot.receive(&inbox(&[(COORDINATOR, encoded(wire::encode_recall))]));
         assert_eq!(founds(&sent(&mut robot)), vec![0, 1]);
     }
@@ -614,7 +620,10 @@ mod tests {
             };
             encoded(|p| wire::encode_assign(&a, p))
         };
-        robot.receive(&inbox(&[(FROM_WORLD, setup()), (COORDINATOR, assign(0, 1))]));
+        robot.receive(&inbox(&[
+            (FROM_WORLD, setup()),
+            (COORDINATOR, assign(0, 1)),
+        ]));
         assert!(assigned(&robot, &frame));
         take_task(&mut robot, &frame, &mut ActuatorCommand::idle(ME, 0));
         assert!(!assigned(&robot, &frame) && !at_task(&robot, &frame));
@@ -624,7 +633,10 @@ mod tests {
         // A cancel from someone else than the coordinator is ignored; from the coordinator it counts.
         robot.receive(&inbox(&[(3, encoded(|p| wire::encode_cancel(0, p)))]));
         assert!(!cancelled(&robot, &frame));
-        robot.receive(&inbox(&[(COORDINATOR, encoded(|p| wire::encode_cancel(0, p)))]));
+        robot.receive(&inbox(&[(
+            COORDINATOR,
+            encoded(|p| wire::encode_cancel(0, p)),
+        )]));
         assert!(cancelled(&robot, &frame));
         // An offer of a task known to be complete is no assignment.
         let mut robot = Explorer::from_params(&Params::default()).unwrap();

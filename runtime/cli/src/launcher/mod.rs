@@ -137,10 +137,14 @@ pub enum LaunchError {
     #[error("{0}")]
     Config(#[from] ConfigErrors),
     /// The configuration has no robot to run.
-    #[error("{path}: the arena has no e-puck, so there is nothing to run")]
+    #[error(
+        "{path}:{at}: the arena has no robot (e-puck, foot-bot or disc-robot), so there is nothing to run"
+    )]
     NoRobots {
         /// The configuration.
         path: PathBuf,
+        /// Where its `<arena>` element is.
+        at: swarm_contract::config::model::Location,
     },
     /// The world or agent programs are missing.
     #[error(transparent)]
@@ -247,6 +251,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     if bodies == 0 {
         return Err(LaunchError::NoRobots {
             path: options.config.clone(),
+            at: experiment.arena.location,
         });
     }
     let robots = roster.len() as u32;
