@@ -12,10 +12,11 @@
 //! | 6 | [`PlanReport`]: a path planner's statistics for its current task | robot -> task server |
 //!
 //! A map or snapshot longer than one payload is sent as several chunks in the same tick; each says how many
-//! entries the whole has and where it starts. The exploration task's letters are in [`exploration`], with tags of
-//! their own.
+//! entries the whole has and where it starts. The exploration task's letters are in [`exploration`] and cooperative
+//! transport's in [`transport`], each with tags of their own.
 
 pub mod exploration;
+pub mod transport;
 
 use crate::V2;
 use crate::apf::{Disc, Neighbour, Status};
