@@ -13,6 +13,7 @@ pub mod pheromone_foraging;
 pub mod phototaxis;
 pub mod synchronisation;
 pub mod timer;
+pub mod transport;
 
 use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::{ActuatorCommand, SensorFrame};
@@ -33,6 +34,7 @@ use path_planning::PathPlanner;
 use pheromone_foraging::PheromoneForager;
 use phototaxis::Phototaxis;
 use synchronisation::{Synchronisation, SynchronisationSct};
+use transport::Carrier;
 
 /// What a bound profile is to the agent: the player's callbacks and the profile's messages.
 trait ProfileCallbacks: EventCallbacks + Talk + Send {}
@@ -89,6 +91,7 @@ const PROFILES: &[(&str, BindFn)] = &[
     (Navigator::NAME, bind_boxed::<Navigator>),
     (PathPlanner::NAME, bind_boxed::<PathPlanner>),
     (Explorer::NAME, bind_boxed::<Explorer>),
+    (Carrier::NAME, bind_boxed::<Carrier>),
 ];
 
 /// Why a profile could not be set up.
@@ -176,7 +179,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning, exploration)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning, exploration, transport)"
         );
     }
 

@@ -6,7 +6,7 @@
 //! | 32 | [`Object`]: the box now, its goal pose, the team and the robot's face | supervisor (the task server) -> robot |
 //! | 33 | `PathRequest`: plan a global path for the box (the method's `Global_PP`) | robot -> supervisor |
 //! | 34 | [`PathChunk`]: part of the box's path | supervisor -> robot |
-//! | 35 | [`Signal`]: the team's protocol (presence, RT, Y, T, A, P, S, deviations) | robot -> robot |
+//! | 35 | [`Signal`]: the team's protocol (presence, RT, Y, T, A, P, S, deviations, LPP/GPP) | robot -> robot |
 //! | 36 | [`Outcome`]: how the task ended for the team | coordinator robot -> supervisor |
 //!
 //! A path longer than one letter goes as several chunks in the same tick, each saying how many points the whole
@@ -97,6 +97,10 @@ pub enum Code {
     Stop,
     /// "I moved aside to avoid an obstacle, follow": the box's next waypoints shift by `value`.
     Deviate,
+    /// The path is built locally, by every robot alike (the method's `LPP`; coordinator -> all).
+    LocalPath,
+    /// The path comes from the supervisor (the method's `GPP`; coordinator -> all).
+    GlobalPath,
 }
 
 /// One protocol message.
@@ -142,6 +146,8 @@ fn code_byte(code: Code) -> u8 {
         Code::Put => 5,
         Code::Stop => 6,
         Code::Deviate => 7,
+        Code::LocalPath => 8,
+        Code::GlobalPath => 9,
     }
 }
 
@@ -155,6 +161,8 @@ fn code(byte: u8) -> Result<Code, WireError> {
         5 => Code::Put,
         6 => Code::Stop,
         7 => Code::Deviate,
+        8 => Code::LocalPath,
+        9 => Code::GlobalPath,
         _ => return Err(WireError::BadNumber),
     })
 }
@@ -198,13 +206,9 @@ pub enum Letter<'a> {
 /// Writes `object` into `out`; returns the payload length.
 pub fn encode_object(object: &Object, out: &mut [u8; PAYLOAD]) -> usize {
     let mut w = Writer { out, at: 0 };
-    w.bytes(&[OBJECT])
-        .f32(object.centre.x)
-        .f32(object.centre.y);
+    w.bytes(&[OBJECT]).f32(object.centre.x).f32(object.centre.y);
     w.f32(object.half.x).f32(object.half.y);
-    w.f32(object.angle)
-        .f32(object.goal.x)
-        .f32(object.goal.y);
+    w.f32(object.angle).f32(object.goal.x).f32(object.goal.y);
     w.f32(object.goal_angle)
         .bytes(&[object.team, object.lift_by, object.face]);
     w.f32(object.tolerance)
@@ -221,7 +225,12 @@ pub fn encode_path_request(out: &mut [u8; PAYLOAD]) -> usize {
 
 /// Writes the chunk of `path` (plan number `plan`) starting at point `first` into `out`; returns the payload
 /// length and the first point of the next chunk (`path.len()` when this was the last). At most 65,535 points.
-pub fn encode_path(plan: u32, path: &[V2], first: usize, out: &mut [u8; PAYLOAD]) -> (usize, usize) {
+pub fn encode_path(
+    plan: u32,
+    path: &[V2],
+    first: usize,
+    out: &mut [u8; PAYLOAD],
+) -> (usize, usize) {
     let end = (first + POINTS_PER_CHUNK).min(path.len());
     let mut w = Writer { out, at: 0 };
     w.bytes(&[PATH])
@@ -374,7 +383,10 @@ mod tests {
             let Ok(Letter::Path(chunk)) = decode(&out[..len]) else {
                 panic!("not a path");
             };
-            assert_eq!((chunk.plan, chunk.total, usize::from(chunk.first)), (3, 70, first));
+            assert_eq!(
+                (chunk.plan, chunk.total, usize::from(chunk.first)),
+                (3, 70, first)
+            );
             seen.extend(chunk.points());
             first = next;
         }
@@ -405,7 +417,7 @@ mod tests {
             },
             &mut out,
         );
-        out[1] = 9;
+        out[1] = 10;
         assert_eq!(decode(&out[..len]), Err(WireError::BadNumber));
         let (len, _) = encode_path(1, &[V2::ZERO, V2::ZERO], 0, &mut out);
         out[5..7].copy_from_slice(&1u16.to_le_bytes());
