@@ -86,6 +86,44 @@ impl<'a> ParamReader<'a> {
         }
     }
 
+    /// Attribute `name` as a whole number in `min..=max`, or `default` when absent.
+    pub fn u64_between(
+        &self,
+        name: &str,
+        default: u64,
+        min: u64,
+        max: u64,
+    ) -> Result<u64, WorldError> {
+        let Some(raw) = self.raw(name) else {
+            return Ok(default);
+        };
+        match raw.trim().parse::<u64>() {
+            Ok(v) if (min..=max).contains(&v) => Ok(v),
+            _ => Err(self.invalid(name, raw, &format!("a whole number from {min} to {max}"))),
+        }
+    }
+
+    /// Attribute `name` as exactly `N` finite numbers separated by commas (e.g. a pose `x,y,angle`), or `None`
+    /// when absent.
+    pub fn numbers<const N: usize>(&self, name: &str) -> Result<Option<[f64; N]>, WorldError> {
+        let Some(raw) = self.raw(name) else {
+            return Ok(None);
+        };
+        let invalid = || self.invalid(name, raw, &format!("{N} numbers separated by `,`"));
+        let mut parts = raw.split(',');
+        let mut out = [0.0; N];
+        for slot in &mut out {
+            match parts.next().map(|v| v.trim().parse::<f64>()) {
+                Some(Ok(v)) if v.is_finite() => *slot = v,
+                _ => return Err(invalid()),
+            }
+        }
+        if parts.next().is_some() {
+            return Err(invalid());
+        }
+        Ok(Some(out))
+    }
+
     /// Attribute `name`, which must be one of `choices`, or `default` when absent.
     pub fn choice(
         &self,
@@ -248,6 +286,36 @@ mod tests {
         let p = params(&[("task.radius", " 0.5 ")]);
         let r = ParamReader::new(&p, "task", &["radius"]).unwrap();
         assert_eq!(r.positive_or_word("radius", "sensor").unwrap(), Some(0.5));
+    }
+
+    #[test]
+    fn bounded_whole_numbers_and_fixed_counts_of_numbers_as_transport_reads_them() {
+        let p = params(&[
+            ("task.n", "7"),
+            ("task.big", "11"),
+            ("task.pose", " 1, -2.5,90 "),
+            ("task.short", "1,2"),
+            ("task.long", "1,2,3,4"),
+            ("task.nan", "1,NaN,3"),
+        ]);
+        let r = ParamReader::new(&p, "task", &["n", "big", "pose", "short", "long", "nan"]).unwrap();
+        assert_eq!(r.u64_between("n", 1, 1, 10).unwrap(), 7);
+        assert_eq!(r.u64_between("absent", 3, 1, 10).unwrap(), 3);
+        assert_eq!(
+            r.u64_between("big", 1, 1, 10).unwrap_err().to_string(),
+            "e.argos:3:5: <task big=\"11\">: must be a whole number from 1 to 10"
+        );
+        assert_eq!(r.numbers::<3>("pose").unwrap(), Some([1.0, -2.5, 90.0]));
+        assert_eq!(r.numbers::<3>("absent").unwrap(), None);
+        for bad in ["short", "long", "nan"] {
+            assert!(
+                r.numbers::<3>(bad)
+                    .unwrap_err()
+                    .to_string()
+                    .ends_with("must be 3 numbers separated by `,`"),
+                "{bad}"
+            );
+        }
     }
 
     #[test]

@@ -16,12 +16,12 @@ pub struct Pose {
 
 impl Pose {
     /// `local`, a point of the box's own frame, in the world.
-    pub fn to_world(&self, local: V2) -> V2 {
+    pub fn to_world(self, local: V2) -> V2 {
         self.centre + rotate(local, self.angle)
     }
 
     /// `world`, a point of the world, in the box's own frame.
-    pub fn to_local(&self, world: V2) -> V2 {
+    pub fn to_local(self, world: V2) -> V2 {
         rotate(world - self.centre, -self.angle)
     }
 }
@@ -43,7 +43,7 @@ fn normal(face: u8) -> V2 {
 
 /// The distance from the box's centre to `face`.
 fn face_distance(half: V2, face: u8) -> f32 {
-    if face % 2 == 0 { half.x } else { half.y }
+    if face.is_multiple_of(2) { half.x } else { half.y }
 }
 
 /// Where a robot of `radius` stands `beyond` metres out from the centre of its face, and the heading that faces
