@@ -13,6 +13,7 @@ pub mod params;
 pub mod pheromone_foraging;
 pub mod phototaxis;
 pub mod synchronisation;
+pub mod transport;
 
 use std::collections::BTreeMap;
 
@@ -144,7 +145,8 @@ pub struct LoopFunctionsRegistry {
 impl Default for LoopFunctionsRegistry {
     /// The built-in loop functions: `obstacle_avoidance_loop_functions`, `aggregation_loop_functions`,
     /// `synchronisation_loop_functions`, `foraging_loop_functions`, `pheromone_foraging_loop_functions`,
-    /// `phototaxis_loop_functions`, `navigation_loop_functions`, `exploration_loop_functions`.
+    /// `phototaxis_loop_functions`, `navigation_loop_functions`, `exploration_loop_functions`,
+    /// `transport_loop_functions`.
     fn default() -> Self {
         let mut registry = Self {
             factories: BTreeMap::new(),
@@ -166,6 +168,7 @@ impl Default for LoopFunctionsRegistry {
         registry.register(phototaxis::LABEL, phototaxis::Phototaxis::factory);
         registry.register(navigation::LABEL, navigation::Navigation::factory);
         registry.register(exploration::LABEL, exploration::Exploration::factory);
+        registry.register(transport::LABEL, transport::Transport::factory);
         registry
     }
 }

@@ -48,7 +48,7 @@ use crate::loop_functions::params::ParamReader;
 use crate::loop_functions::{LoopFunctions, LoopFunctionsParams};
 use crate::rng::{Purpose, stream};
 
-mod planning;
+pub(crate) mod planning;
 use planning::{Totals, TripFigures, reference};
 
 /// The label under which the configuration selects these loop functions.

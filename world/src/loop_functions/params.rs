@@ -298,7 +298,8 @@ mod tests {
             ("task.long", "1,2,3,4"),
             ("task.nan", "1,NaN,3"),
         ]);
-        let r = ParamReader::new(&p, "task", &["n", "big", "pose", "short", "long", "nan"]).unwrap();
+        let r =
+            ParamReader::new(&p, "task", &["n", "big", "pose", "short", "long", "nan"]).unwrap();
         assert_eq!(r.u64_between("n", 1, 1, 10).unwrap(), 7);
         assert_eq!(r.u64_between("absent", 3, 1, 10).unwrap(), 3);
         assert_eq!(

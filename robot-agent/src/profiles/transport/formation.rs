@@ -43,7 +43,11 @@ fn normal(face: u8) -> V2 {
 
 /// The distance from the box's centre to `face`.
 fn face_distance(half: V2, face: u8) -> f32 {
-    if face.is_multiple_of(2) { half.x } else { half.y }
+    if face.is_multiple_of(2) {
+        half.x
+    } else {
+        half.y
+    }
 }
 
 /// Where a robot of `radius` stands `beyond` metres out from the centre of its face, and the heading that faces

@@ -58,6 +58,8 @@ const GRIP_GAP: f32 = 0.005;
 const DROP_TICKS: u32 = 5;
 /// Most points of a path kept.
 const MAX_PATH: usize = 4096;
+/// Waypoints over which a shift of the path fades out.
+const SHIFT_FADE: u32 = 5;
 /// Heading error under which a robot at its standoff point stops turning and creeps in (rad).
 const ALIGNED: f32 = 0.05;
 
@@ -130,14 +132,22 @@ impl Carrier {
         self.waypoints.len().saturating_sub(1) as u32
     }
 
-    /// Where this robot's centre belongs at waypoint `k` (with the announced shifts).
+    /// Where this robot's centre belongs at waypoint `k`. A shift announced from waypoint `from` on moves the
+    /// box aside there and fades out over the next [`SHIFT_FADE`] waypoints: the box goes round the obstacle and
+    /// back to its path, and the goal never moves.
     fn target(&self, k: u32) -> Option<V2> {
         let pose = self.waypoints.get(k as usize)?;
-        let shift = self
-            .shifts
-            .iter()
-            .filter(|(from, _)| *from <= k)
-            .fold(V2::ZERO, |sum, (_, by)| sum + *by);
+        let shift = if k >= self.last() {
+            V2::ZERO
+        } else {
+            self.shifts
+                .iter()
+                .filter(|(from, _)| *from <= k)
+                .fold(V2::ZERO, |sum, (from, by)| {
+                    let weight = 1.0 - (k - from) as f32 / SHIFT_FADE as f32;
+                    sum + *by * weight.max(0.0)
+                })
+        };
         Some(pose.to_world(self.offset?) + shift)
     }
 

@@ -6,10 +6,12 @@
 //!   (again every `repeat` ticks until the lift). The smallest index among the robots heard and not lost
 //!   coordinates, once the whole team is present.
 //! - **Lift.** The coordinator asks `ReadyToTake` (every `repeat` ticks) until every member answered `Yes`; then
-//!   it says `Take` (again to anyone still answering `Yes`) and decides the path (`LocalPath` or `GlobalPath`).
+//!   it says `Take` and decides the path (`LocalPath` or `GlobalPath`), both again every `repeat` ticks until
+//!   every member has reported the first waypoint (and `Take` at once to anyone still answering `Yes`).
 //! - **Barrier.** A robot at waypoint k sends `Arrived(k)` to the coordinator (every `repeat` ticks until it is
-//!   released); when every member has arrived, the coordinator broadcasts `Arrived(k)` (again to anyone who
-//!   reports k later), or `Put` after the last waypoint.
+//!   released); when every member has arrived, the coordinator broadcasts `Arrived(k)` (again, to the reporter
+//!   alone, to anyone who reports k later), or `Put` after the last waypoint. An `Arrived` from the coordinator
+//!   releases; one to the coordinator reports.
 //! - **Timeouts.** A coordinator that waits more than `step_timeout` ticks at a barrier counts the silent
 //!   members lost; a member released by nobody for that long counts the coordinator lost, and the next smallest
 //!   index takes over the barrier. With fewer members left than the box needs, the team stops.
@@ -238,7 +240,8 @@ impl Team {
             Code::GlobalPath => {
                 self.path_mode.get_or_insert(PathMode::Global);
             }
-            Code::Arrived if to == Address::All => {
+            // From the coordinator (to all, or again to this robot after a lost one): go on past `k`.
+            Code::Arrived if to == Address::All || Some(from) == self.coordinator() => {
                 if k > self.released {
                     self.released = k;
                     self.waiting_since = tick;
@@ -330,6 +333,14 @@ impl Team {
     }
 
     fn carrying(&mut self, tick: u64, out: &mut Vec<Outgoing>) {
+        // `Take` and the path decision are repeated until every member has shown, by reaching the first waypoint,
+        // that it heard them.
+        let unheard = self
+            .active()
+            .any(|m| m != self.me && !self.arrived.contains_key(&m));
+        if self.leads() && self.released == 0 && unheard && self.due(Code::Take, 0, tick) {
+            out.push((Address::All, signal(Code::Take, 0)));
+        }
         if self.leads()
             && let Some(mode) = self.path_mode
             && self.released == 0
@@ -508,10 +519,15 @@ mod tests {
         // The coordinator released 1 already and hears a late report: it answers the reporter alone.
         a.released = 1;
         a.hear(1, Address::To(0), first[0].1, 11);
-        assert_eq!(
-            codes(&a.outgoing(11)),
-            vec![(Address::To(1), Code::Arrived, 1)]
-        );
+        let answer: Vec<Outgoing> = a
+            .outgoing(11)
+            .into_iter()
+            .filter(|(_, s)| s.code == Code::Arrived)
+            .collect();
+        assert_eq!(codes(&answer), vec![(Address::To(1), Code::Arrived, 1)]);
+        // The answer to it alone releases it too.
+        deliver(&answer, 0, &mut b, 12);
+        assert_eq!(b.released(), 1);
     }
 
     #[test]
@@ -521,16 +537,19 @@ mod tests {
         a.took_at = Some(0);
         a.set_last(5);
         a.arrive(1, 0);
-        assert!(a.outgoing(0).is_empty());
-        assert!(a.outgoing(50).is_empty());
+        let only = |out: Vec<Outgoing>, code: Code| {
+            out.into_iter().filter(|(_, s)| s.code == code).count()
+        };
+        // Until the member reports the first waypoint, only `Take` is repeated.
+        assert_eq!(only(a.outgoing(0), Code::Take), 1);
+        assert_eq!(only(a.outgoing(50), Code::Arrived), 0);
         assert!(a.stopped().is_none());
-        let out = a.outgoing(51);
+        a.outgoing(51);
         assert_eq!(a.stopped(), Some(Ending::TeammateLost));
         // Three stops, `repeat` ticks apart, then quiet.
-        let mut stops = codes(&out).len();
-        for tick in 52..200 {
-            stops += a.outgoing(tick).len();
-        }
+        let stops: usize = (52..200)
+            .map(|tick| only(a.outgoing(tick), Code::Stop))
+            .sum();
         assert_eq!(stops, 3);
         // With three robots and a box two can lift, the team goes on without the silent one.
         let mut c = Team::new(0, TIMING);
