@@ -128,6 +128,28 @@ fn three_carriers_lose_one_and_the_two_left_deliver_the_box_even_without_their_c
 }
 
 #[test]
+fn a_post_nobody_planned_for_is_passed_by_moving_the_whole_formation_aside() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("deviated");
+    run_to_completion("configs/transport/unseen.argos", &out, &[]);
+    assert_delivered(&out);
+    let m = &summary(&out)["metrics"];
+    // A local path (no plan asked for), and the box went round: longer than the straight 2.6 m.
+    assert_eq!(m["plans"], 0, "{m}");
+    assert!(m["object_path_m"].as_f64().expect("a length") > 2.61, "{m}");
+    // Without the field's push the box runs into the post and the team never finishes the path.
+    let config = edited_config(dir.path(), "configs/transport/unseen.argos", |text| {
+        text.replace(
+            "profile=\"transport\"",
+            "profile=\"transport\" alpha=\"0\" beta=\"0\"",
+        )
+    });
+    let out = dir.path().join("straight");
+    run_to_completion(&config, &out, &[]);
+    assert_eq!(summary(&out)["metrics"]["success"], false);
+}
+
+#[test]
 fn lost_messages_are_sent_again_and_the_box_still_arrives() {
     let dir = tempfile::tempdir().expect("tempdir");
     let config = edited_config(dir.path(), TWO, |text| {

@@ -407,21 +407,40 @@ fn carry(s: &mut Carrier, frame: &SensorFrame, command: &mut ActuatorCommand) {
 }
 
 impl Carrier {
-    /// The method's "I moved aside, follow": an obstacle nearer than `range1` that is neither the box nor a
-    /// teammate (both lie within the formation around the box) pushes the rest of the path away from it, once
-    /// per waypoint.
+    /// The method's "I moved aside, follow": an obstacle within the field's `range2` that is neither the box nor
+    /// a teammate (both near the box's outline: the box itself, and a robot at the centre of a face) pushes the
+    /// rest of the path away from it by the bounded field of B.4, once per waypoint.
     fn deviation(&self, scan: &Scan<'_>) -> Option<V2> {
         if self.deviated >= self.k {
             return None;
         }
         let (object, offset) = (self.object()?, self.offset?);
-        let pose = self.waypoints.get(self.k as usize)?;
-        // The box's centre now, from where this robot holds it.
-        let centre = scan.position - (pose.to_world(offset) - pose.centre);
-        let footprint = object.half.length() + 2.0 * self.radius + 0.05;
+        let pose = *self.waypoints.get(self.k as usize)?;
+        // The box now, from where this robot holds it.
+        let now = Pose {
+            centre: scan.position - (pose.to_world(offset) - pose.centre),
+            angle: pose.angle,
+        };
+        let margin = 0.05;
+        let faces = [
+            V2::new(object.half.x + self.radius, 0.0),
+            V2::new(-object.half.x - self.radius, 0.0),
+            V2::new(0.0, object.half.y + self.radius),
+            V2::new(0.0, -object.half.y - self.radius),
+        ];
+        let ours = |hit: V2| {
+            let local = now.to_local(hit);
+            let on_box =
+                local.x.abs() <= object.half.x + margin && local.y.abs() <= object.half.y + margin;
+            on_box
+                || faces
+                    .iter()
+                    .any(|f| (local - *f).length() <= self.radius + margin)
+        };
         let n = scan.ranges.len();
-        let nearest = (0..n)
-            .filter(|&k| scan.ranges[k].is_finite() && scan.ranges[k] < self.correction.range1)
+        let c = self.correction;
+        let (d, hit) = (0..n)
+            .filter(|&k| scan.ranges[k].is_finite() && scan.ranges[k] < c.range2)
             .map(|k| {
                 let angle = scan.heading + std::f32::consts::TAU * k as f32 / n as f32;
                 (
@@ -429,11 +448,14 @@ impl Carrier {
                     scan.position + V2::from_angle(angle) * scan.ranges[k],
                 )
             })
-            .filter(|(_, hit)| (*hit - centre).length() > footprint)
+            .filter(|(_, hit)| !ours(*hit))
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
-        let away = scan.position - nearest.1;
-        let strength =
-            self.correction.alpha * (self.correction.range1 - nearest.0) / self.correction.range1;
+        let strength = if d < c.range1 {
+            c.alpha * (c.range1 - d) / c.range1
+        } else {
+            c.beta * (c.range2 - d) / (c.range2 - c.range1)
+        };
+        let away = scan.position - hit;
         Some(away * (strength * self.step * 0.5 / away.length().max(1e-6)))
     }
 }
