@@ -370,7 +370,8 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "unknown profile `flocking` in <params> (known profiles: obstacle_avoidance, obstacle_avoidance_sct, \
-             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning)"
+             aggregation, synchronisation, synchronisation_sct, foraging, pheromone_foraging, phototaxis, navigation, path_planning, exploration, \
+             transport)"
         );
     }
 
@@ -384,7 +385,7 @@ mod tests {
              footbot_diffusion_controller, footbot_flocking_controller, footbot_foraging_controller, \
              footbot_gripping_controller, footbot_synchronization_controller, epuck_obstacleavoidance, \
              footbot_diffusion, footbot_flocking, footbot_foraging, footbot_gripping, footbot_synchronization, \
-             disc_wander, mail_probe, navigation_coordinator, sensor_probe"
+             disc_wander, mail_probe, exploration_coordinator, navigation_coordinator, sensor_probe"
         );
     }
 }
