@@ -602,6 +602,33 @@ pub fn element_line(path: &str, element: &str) -> usize {
         .unwrap_or_else(|| panic!("no <{element}> element in {path}"))
 }
 
+/// The run's `summary.json`.
+pub fn run_summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+/// Runs `config` to completion twice, each into a fresh temporary folder (for determinism checks).
+pub fn run_twice(config: &str, extra: &[&str]) -> [tempfile::TempDir; 2] {
+    let runs = [(); 2].map(|_| tempfile::tempdir().expect("tempdir"));
+    for out in &runs {
+        run_to_completion(config, out.path(), extra);
+    }
+    runs
+}
+
+/// The shipped configuration `config` with `faults` (elements of a `<faults>` section) added to its schedule,
+/// written into `dir` as [`edited_config`] does.
+pub fn with_faults(dir: &Path, config: &str, faults: &str) -> String {
+    edited_config(dir, config, |text| match text.find("</faults>") {
+        Some(end) => format!("{}    {faults}\n  {}", &text[..end], &text[end..]),
+        None => text.replace(
+            "</argos-configuration>",
+            &format!("  <faults>{faults}</faults>\n</argos-configuration>"),
+        ),
+    })
+}
+
 /// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.
 pub fn assert_same_records(a: &Path, b: &Path, files: &[&str]) {
     for file in files {

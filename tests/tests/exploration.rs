@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, element_line, run_to_completion, swarm,
+    assert_same_records, edited_config, element_line, run_summary, run_to_completion, run_twice,
+    swarm, with_faults,
 };
 
 const SMALL: &str = "configs/exploration/small.argos";
@@ -14,9 +15,7 @@ const SMALL: &str = "configs/exploration/small.argos";
 const COORDINATOR: u32 = 3;
 
 fn metrics(out: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-    let summary: serde_json::Value = serde_json::from_str(&text).expect("summary.json is JSON");
-    summary["metrics"].clone()
+    run_summary(out)["metrics"].clone()
 }
 
 /// The rows of `exploration.csv` with `event`, as their fields.
@@ -44,24 +43,9 @@ fn events(out: &Path, event: &str) -> Vec<(u64, u32)> {
         .collect()
 }
 
-/// `small.argos` with a fault schedule added (the coordinator's restart policy kept).
-fn with_faults(dir: &Path, faults: &str) -> String {
-    edited_config(dir, SMALL, |text| {
-        text.replace(
-            "<restart policy=\"on-failure\" controller=\"allocator\" />",
-            &format!("<restart policy=\"on-failure\" controller=\"allocator\" />\n    {faults}"),
-        )
-    })
-}
-
 #[test]
 fn a_small_problem_is_explored_and_every_task_done_the_same_way_for_a_seed() {
-    let runs: Vec<tempfile::TempDir> = (0..2)
-        .map(|_| tempfile::tempdir().expect("tempdir"))
-        .collect();
-    for out in &runs {
-        run_to_completion(SMALL, out.path(), &[]);
-    }
+    let runs = run_twice(SMALL, &[]);
     let out = runs[0].path();
     let m = metrics(out);
     assert_eq!(m["tasks"], 3, "{m}");
@@ -107,7 +91,7 @@ fn a_robot_killed_on_its_way_loses_its_task_to_the_survivors_the_same_way_every_
     let (taken, robot) = events(&baseline, "take_task")[0];
     let kill = taken + 10;
     let faults = format!("<kill robots=\"{robot}\" tick=\"{kill}\" />");
-    let config = with_faults(dir.path(), &faults);
+    let config = with_faults(dir.path(), SMALL, &faults);
     let out = dir.path().join("killed");
     run_to_completion(&config, &out, &[]);
     // The same seed and fault schedule give the same run.
@@ -150,7 +134,7 @@ fn a_killed_coordinator_is_restarted_and_loses_no_task_the_robots_found() {
     let discovered = tick(&task_rows(&baseline, "discovered")[0]);
     let kill = discovered + 2;
     let faults = format!("<kill robots=\"{COORDINATOR}\" tick=\"{kill}\" />");
-    let config = with_faults(dir.path(), &faults);
+    let config = with_faults(dir.path(), SMALL, &faults);
     let out = dir.path().join("killed");
     run_to_completion(&config, &out, &[]);
     let m = metrics(&out);

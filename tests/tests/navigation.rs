@@ -5,15 +5,11 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, element_line, run_to_completion, swarm,
+    assert_same_records, edited_config, element_line, run_summary, run_to_completion, run_twice,
+    swarm, with_faults,
 };
 
 const CASE1: &str = "configs/navigation/case1.argos";
-
-fn summary(out: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("summary.json is JSON")
-}
 
 /// `(x, y)` of every robot in `tick`'s rows of `trajectory.csv`.
 fn poses(out: &Path, tick: u64) -> Vec<(f64, f64)> {
@@ -29,14 +25,9 @@ fn poses(out: &Path, tick: u64) -> Vec<(f64, f64)> {
 
 #[test]
 fn eight_robots_cross_the_obstacle_rows_and_every_one_arrives_the_same_way_for_a_seed() {
-    let runs: Vec<tempfile::TempDir> = (0..2)
-        .map(|_| tempfile::tempdir().expect("tempdir"))
-        .collect();
-    for out in &runs {
-        run_to_completion(CASE1, out.path(), &[]);
-    }
+    let runs = run_twice(CASE1, &[]);
     let out = runs[0].path();
-    let metrics = &summary(out)["metrics"];
+    let metrics = &run_summary(out)["metrics"];
     assert_eq!(metrics["robots"], 8, "{metrics}");
     assert_eq!(metrics["failures"], 0, "{metrics}");
     assert_eq!(metrics["tasks_completed"], 8, "{metrics}");
@@ -68,16 +59,14 @@ fn eight_robots_cross_the_obstacle_rows_and_every_one_arrives_the_same_way_for_a
 #[test]
 fn without_the_coordinator_robots_hold_still_and_they_finish_once_it_is_back() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let config = edited_config(dir.path(), CASE1, |text| {
-        text.replace(
-            "</argos-configuration>",
-            "<faults><kill robots=\"8\" tick=\"200\" />\
-             <restart policy=\"on-failure\" robots=\"8\" backoff=\"2\" /></faults>\n</argos-configuration>",
-        )
-    });
+    let config = with_faults(
+        dir.path(),
+        CASE1,
+        "<kill robots=\"8\" tick=\"200\" /><restart policy=\"on-failure\" robots=\"8\" backoff=\"2\" />",
+    );
     let out = dir.path().join("run");
     run_to_completion(&config, &out, &[]);
-    let metrics = &summary(&out)["metrics"];
+    let metrics = &run_summary(&out)["metrics"];
     assert_eq!(metrics["failures"], 0, "{metrics}");
     // Ten ticks without a snapshot and every robot halts; nothing moves until the coordinator is back.
     let (still_from, still_to) = (215, 235);
@@ -109,7 +98,7 @@ fn robots_joining_a_lifelong_run_get_goals_and_everyone_gets_new_ones_on_arrival
         out.path(),
         &["--ticks", "900"],
     );
-    let metrics = &summary(out.path())["metrics"];
+    let metrics = &run_summary(out.path())["metrics"];
     let completed = metrics["tasks_completed"].as_u64().expect("a count");
     assert!(completed > 8, "{metrics}");
     let arrivals =

@@ -6,16 +6,15 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, run_to_completion, swarm, workspace_file,
+    assert_same_records, edited_config, run_summary, run_to_completion, run_twice, swarm,
+    workspace_file,
 };
 
 const HIDDEN: &str = "configs/planning/hidden.argos";
 const ROBOT_RADIUS: f64 = 0.105;
 
 fn metrics(out: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-    let summary: serde_json::Value = serde_json::from_str(&text).expect("summary.json is JSON");
-    summary["metrics"].clone()
+    run_summary(out)["metrics"].clone()
 }
 
 /// Every cylinder of the configuration at `path`: id, centre and radius.
@@ -77,12 +76,7 @@ fn ring_round(x: f64, y: f64) -> String {
 
 #[test]
 fn a_gsa_robot_finds_the_hidden_cylinders_replans_and_arrives_the_same_way_for_a_seed() {
-    let runs: Vec<tempfile::TempDir> = (0..2)
-        .map(|_| tempfile::tempdir().expect("tempdir"))
-        .collect();
-    for out in &runs {
-        run_to_completion(HIDDEN, out.path(), &[]);
-    }
+    let runs = run_twice(HIDDEN, &[]);
     let out = runs[0].path();
     let m = metrics(out);
     assert_eq!(m["tasks_completed"], 1, "{m}");

@@ -6,17 +6,13 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, element_line, run_to_completion, swarm,
+    assert_same_records, edited_config, element_line, run_summary, run_to_completion, run_twice,
+    swarm, with_faults,
 };
 
 const TWO: &str = "configs/transport/sample2.argos";
 const THREE: &str = "configs/transport/sample3.argos";
 const OBSTACLES: &str = "configs/transport/sample4.argos";
-
-fn summary(out: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("summary.json is JSON")
-}
 
 /// The tick of the first `event` row of `transport.csv`.
 fn first(out: &Path, event: &str) -> u64 {
@@ -30,18 +26,8 @@ fn first(out: &Path, event: &str) -> u64 {
         .expect("a tick")
 }
 
-/// `config` with a fault schedule added.
-fn with_faults(dir: &Path, config: &str, faults: &str) -> String {
-    edited_config(dir, config, |text| {
-        text.replace(
-            "</argos-configuration>",
-            &format!("  <faults>{faults}</faults>\n</argos-configuration>"),
-        )
-    })
-}
-
 fn assert_delivered(out: &Path) {
-    let m = &summary(out)["metrics"];
+    let m = &run_summary(out)["metrics"];
     assert_eq!(m["outcome"], "delivered", "{m}");
     assert_eq!(m["success"], true, "{m}");
     assert!(
@@ -56,12 +42,7 @@ fn assert_delivered(out: &Path) {
 
 #[test]
 fn two_robots_carry_the_box_to_its_goal_pose_the_same_way_for_a_seed() {
-    let runs: Vec<tempfile::TempDir> = (0..2)
-        .map(|_| tempfile::tempdir().expect("tempdir"))
-        .collect();
-    for out in &runs {
-        run_to_completion(TWO, out.path(), &[]);
-    }
+    let runs = run_twice(TWO, &[]);
     let out = runs[0].path();
     assert_delivered(out);
     // The box was lifted before it moved and lowered at the end.
@@ -93,7 +74,7 @@ fn a_carrier_killed_mid_carry_makes_its_teammate_put_the_box_down_and_the_run_en
     );
     let out = dir.path().join("killed");
     run_to_completion(&config, &out, &[]);
-    let s = summary(&out);
+    let s = run_summary(&out);
     let m = &s["metrics"];
     assert_eq!(m["outcome"], "dropped", "{m}");
     assert_eq!(m["success"], false, "{m}");
@@ -133,7 +114,7 @@ fn a_post_nobody_planned_for_is_passed_by_moving_the_whole_formation_aside() {
     let out = dir.path().join("deviated");
     run_to_completion("configs/transport/unseen.argos", &out, &[]);
     assert_delivered(&out);
-    let m = &summary(&out)["metrics"];
+    let m = &run_summary(&out)["metrics"];
     // A local path (no plan asked for), and the box went round: longer than the straight 2.6 m.
     assert_eq!(m["plans"], 0, "{m}");
     assert!(m["object_path_m"].as_f64().expect("a length") > 2.61, "{m}");
@@ -146,7 +127,7 @@ fn a_post_nobody_planned_for_is_passed_by_moving_the_whole_formation_aside() {
     });
     let out = dir.path().join("straight");
     run_to_completion(&config, &out, &[]);
-    assert_eq!(summary(&out)["metrics"]["success"], false);
+    assert_eq!(run_summary(&out)["metrics"]["success"], false);
 }
 
 #[test]

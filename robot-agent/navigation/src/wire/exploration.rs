@@ -20,7 +20,7 @@
 
 use swarm_allocation::Kind;
 
-use super::{PAYLOAD, Reader, WireError, Writer};
+use super::{PAYLOAD, Reader, WireError, Writer, exact};
 use crate::V2;
 
 const SETUP: u8 = 16;
@@ -360,16 +360,7 @@ pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
         tag,
         len: payload.len(),
     };
-    let exact = |len: usize| {
-        if payload.len() == len {
-            Ok(Reader {
-                bytes: payload,
-                at: 1,
-            })
-        } else {
-            Err(bad_length)
-        }
-    };
+    let exact = |len: usize| exact(payload, len);
     match tag {
         SETUP => {
             let mut r = exact(SETUP_LEN)?;

@@ -201,6 +201,21 @@ impl Reader<'_> {
     }
 }
 
+/// A reader past the tag of `payload` (not empty), which must be `len` bytes long.
+fn exact(payload: &[u8], len: usize) -> Result<Reader<'_>, WireError> {
+    if payload.len() == len {
+        Ok(Reader {
+            bytes: payload,
+            at: 1,
+        })
+    } else {
+        Err(WireError::Length {
+            tag: payload[0],
+            len: payload.len(),
+        })
+    }
+}
+
 /// Writes `task` into `out`; returns the payload length.
 pub fn encode_task(task: &Task, out: &mut [u8; PAYLOAD]) -> usize {
     let mut w = Writer { out, at: 0 };
@@ -335,19 +350,7 @@ fn chunk(payload: &[u8], tag: u8, entry: usize) -> Result<Chunk<'_>, WireError> 
 /// Decodes a navigation payload.
 pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
     let &tag = payload.first().ok_or(WireError::Empty)?;
-    let exact = |len: usize| {
-        if payload.len() == len {
-            Ok(Reader {
-                bytes: payload,
-                at: 1,
-            })
-        } else {
-            Err(WireError::Length {
-                tag,
-                len: payload.len(),
-            })
-        }
-    };
+    let exact = |len: usize| exact(payload, len);
     match tag {
         TASK => {
             let mut r = exact(TASK_LEN)?;

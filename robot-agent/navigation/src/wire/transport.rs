@@ -12,7 +12,7 @@
 //! A path longer than one letter goes as several chunks in the same tick, each saying how many points the whole
 //! has and where it starts.
 
-use super::{PAYLOAD, Reader, WireError, Writer};
+use super::{PAYLOAD, Reader, WireError, Writer, exact};
 use crate::V2;
 
 const OBJECT: u8 = 32;
@@ -269,16 +269,7 @@ pub fn decode(payload: &[u8]) -> Result<Letter<'_>, WireError> {
         tag,
         len: payload.len(),
     };
-    let exact = |len: usize| {
-        if payload.len() == len {
-            Ok(Reader {
-                bytes: payload,
-                at: 1,
-            })
-        } else {
-            Err(bad_length)
-        }
-    };
+    let exact = |len: usize| exact(payload, len);
     match tag {
         OBJECT => {
             let mut r = exact(OBJECT_LEN)?;
