@@ -602,6 +602,21 @@ pub fn element_line(path: &str, element: &str) -> usize {
         .unwrap_or_else(|| panic!("no <{element}> element in {path}"))
 }
 
+/// Asserts that `swarm run <config>` (a file in `dir`) is refused with an error at the line of the config's first
+/// `<element` that says `expected`.
+pub fn assert_refused(dir: &Path, config: &str, element: &str, expected: &str) {
+    let run = dir.join("run").display().to_string();
+    let outcome = swarm(&["run", config, "--out", &run, "--overwrite"]);
+    assert!(
+        !outcome.output.status.success(),
+        "{config} was accepted (expected: {expected})"
+    );
+    let stderr = outcome.stderr();
+    let place = format!("{config}:{}:", element_line(config, element));
+    assert!(stderr.contains(&place), "no `{place}` in\n{stderr}");
+    assert!(stderr.contains(expected), "no `{expected}` in\n{stderr}");
+}
+
 /// The run's `summary.json`.
 pub fn run_summary(out: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");

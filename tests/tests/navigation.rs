@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, element_line, run_summary, run_to_completion, run_twice,
+    assert_refused, assert_same_records, edited_config, run_summary, run_to_completion, run_twice,
     swarm, with_faults,
 };
 
@@ -143,21 +143,7 @@ fn impossible_tasks_are_refused_with_the_place_in_the_configuration() {
         let config = edited_config(dir.path(), CASE1, |text| {
             text.replace("radius=\"4.5\"", edit)
         });
-        let run = dir.path().join("run").display().to_string();
-        let outcome = swarm(&["run", &config, "--out", &run, "--overwrite"]);
-        assert!(!outcome.output.status.success(), "{edit} was accepted");
-        let stderr = outcome.stderr();
-        assert!(
-            stderr.contains(&format!(
-                "{config}:{}:",
-                element_line(&config, "loop_functions")
-            )),
-            "{edit}: no location in\n{stderr}"
-        );
-        assert!(
-            stderr.contains(expected),
-            "{edit}: no `{expected}` in\n{stderr}"
-        );
+        assert_refused(dir.path(), &config, "loop_functions", expected);
     }
     let config = edited_config(dir.path(), CASE1, |text| {
         text.replace("layout=\"circle\"", "layout=\"spiral\"")

@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use swarm_system_tests::{
-    assert_same_records, edited_config, element_line, run_summary, run_to_completion, run_twice,
-    swarm, with_faults,
+    assert_refused, assert_same_records, edited_config, run_summary, run_to_completion, run_twice,
+    with_faults,
 };
 
 const TWO: &str = "configs/transport/sample2.argos";
@@ -181,17 +181,6 @@ fn impossible_transports_are_refused_with_the_place_in_the_configuration() {
     ];
     for (edit, expected) in cases {
         let config = edited_config(dir.path(), OBSTACLES, edit);
-        let run = dir.path().join("run").display().to_string();
-        let outcome = swarm(&["run", &config, "--out", &run, "--overwrite"]);
-        assert!(!outcome.output.status.success(), "{expected}: accepted");
-        let stderr = outcome.stderr();
-        assert!(
-            stderr.contains(&format!(
-                "{config}:{}:",
-                element_line(&config, "loop_functions")
-            )),
-            "{expected}: no location in\n{stderr}"
-        );
-        assert!(stderr.contains(expected), "no `{expected}` in\n{stderr}");
+        assert_refused(dir.path(), &config, "loop_functions", expected);
     }
 }
