@@ -235,8 +235,7 @@ impl AgentLink {
         sync: &SyncBlock,
         board_wait: Duration,
     ) -> Result<(Ports, Option<MailPorts>), TransportError> {
-        if sync.is_dead(robot) {
-            // A replacement: the dead agent may still hold the writer slot of the robot's current board.
+        if sync.needs_fresh_board(robot) {
             sync.request_board(robot);
         }
         let waited = Instant::now();
@@ -246,6 +245,7 @@ impl AgentLink {
                     robot,
                     waited_ms: waited.elapsed().as_millis(),
                 })?;
+        sync.mark_used(robot);
         let node = services::node(run, &format!("robot-{robot}"))?;
         let (frame_board, frame_reader, frame_entry) = Self::read_own_entry::<SensorFrame>(
             &node,

@@ -32,7 +32,7 @@ use super::futex::{self, LineWord};
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 9;
+const LAYOUT_VERSION: u32 = 10;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -85,6 +85,10 @@ struct RobotSlot {
     owner_pid: AtomicU32,
     /// 1 after a death notice, until a replacement agent joins.
     dead: AtomicU32,
+    /// 1 once an agent has opened this robot's command board: from then on a replacement needs a fresh board,
+    /// since the board's single writer slot may be held by the dead agent. At start-up every robot has a
+    /// death notice but an untouched board.
+    used: AtomicU32,
     /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
     /// death (a board's single writer slot stays taken by a dead writer, so a replacement gets a fresh board).
     board: AtomicU32,
@@ -522,6 +526,19 @@ impl SyncBlock {
         }
     }
 
+    /// An agent is about to open `robot`'s command board.
+    pub(crate) fn mark_used(&self, robot: u32) {
+        self.slot(robot).used.store(1, Ordering::Release);
+    }
+
+    /// Whether an agent joining for `robot` must ask for a fresh command board: the robot has a death notice
+    /// and an agent has opened its board before (the dead one may still hold the board's writer slot). At
+    /// start-up every robot has a death notice, but no agent has touched its board.
+    pub(crate) fn needs_fresh_board(&self, robot: u32) -> bool {
+        let slot = self.slot(robot);
+        slot.dead.load(Ordering::Acquire) != 0 && slot.used.load(Ordering::Acquire) != 0
+    }
+
     /// Whether `robot` has a death notice and no replacement yet.
     pub(crate) fn is_dead(&self, robot: u32) -> bool {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
@@ -744,6 +761,30 @@ mod tests {
         fn drop(&mut self) {
             let _ = std::fs::remove_file(&self.path);
         }
+    }
+
+    #[test]
+    fn only_a_replacement_needs_a_fresh_command_board() {
+        let path = PathBuf::from(format!(
+            "/dev/shm/swarm-test-{}-fresh-board",
+            std::process::id()
+        ));
+        let test = TestBlock {
+            block: SyncBlock::create(&path, 2, 2, AgentPlacement::default())
+                .expect("create the block"),
+            path,
+        };
+        let block = &test.block;
+        // Start-up: every robot has a death notice until its agent joins, and its board is untouched.
+        block.mark_dead(0);
+        assert!(!block.needs_fresh_board(0));
+        block.mark_used(0);
+        block.announce_ready(0);
+        assert!(!block.needs_fresh_board(0));
+        // The agent dies: its replacement needs a fresh board.
+        block.mark_dead(0);
+        assert!(block.needs_fresh_board(0));
+        assert!(!block.needs_fresh_board(1));
     }
 
     #[test]
