@@ -253,7 +253,6 @@ fn run(args: &Args) -> Result<()> {
 }
 
 fn main() -> ExitCode {
-    swarm_contract::process::children::die_with_parent();
     swarm_contract::logging::init("info,supervisor_gen=warn");
     match run(&Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,

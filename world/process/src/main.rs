@@ -55,7 +55,6 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    swarm_contract::process::children::die_with_parent();
     swarm_contract::logging::init("info");
     let cli = Cli::parse();
     match run(&cli.args, &cli.hosts) {

@@ -2,8 +2,8 @@
 //!
 //! Children run in their own process group, so a Ctrl-C in the terminal reaches only the launcher, which then
 //! stops the run in order (world first, so it flushes its records). Each child also gets `SIGKILL` from the kernel
-//! when the launcher dies (`PR_SET_PDEATHSIG`, which the child arms itself first thing: [`die_with_parent`]), so no
-//! robot outlives a killed launcher. Dropping [`Children`] kills and reaps every child that is still running.
+//! when the launcher dies (`PR_SET_PDEATHSIG`), so no robot outlives a killed launcher. Dropping [`Children`]
+//! kills and reaps every child that is still running.
 
 use std::os::unix::process::CommandExt;
 use std::process::{Child, Command, ExitStatus};
@@ -14,37 +14,25 @@ use nix::sys::signal::{Signal, kill};
 use nix::sys::wait::{Id, WaitPidFlag, WaitStatus, waitid};
 use nix::unistd::Pid;
 
-/// The environment variable through which a supervised child learns its parent's process id.
-pub const PARENT_PID_ENV: &str = "SWARM_PARENT_PID";
-
-/// Starts `command` as a supervised child: own process group, killed with the launcher once the child has called
-/// [`die_with_parent`] (every program a run starts does so first thing).
-///
-/// The child arms its own death signal rather than a `pre_exec` hook doing it between fork and exec: without a
-/// hook the standard library starts the child with `posix_spawn`, which does not copy the launcher's page tables,
-/// and a run starts one child per robot (BENCHMARKS.md, "Start-up").
+/// Starts `command` as a supervised child: own process group, killed with the launcher.
 pub fn spawn(command: &mut Command) -> std::io::Result<Child> {
-    command
-        .process_group(0)
-        .env(PARENT_PID_ENV, nix::unistd::getpid().to_string());
-    command.spawn()
-}
-
-/// In a child started by [`spawn`]: asks the kernel for `SIGKILL` when the parent dies, and exits at once if
-/// the parent died before that (it would send no signal any more). Does nothing in a process started otherwise.
-pub fn die_with_parent() {
-    let Some(parent) = std::env::var(PARENT_PID_ENV)
-        .ok()
-        .and_then(|pid| pid.parse::<i32>().ok())
-    else {
-        return;
-    };
-    if nix::sys::prctl::set_pdeathsig(Signal::SIGKILL).is_err()
-        || nix::unistd::getppid() != Pid::from_raw(parent)
-    {
-        eprintln!("error: the process that started this one has ended");
-        std::process::exit(1);
+    command.process_group(0);
+    let parent = nix::unistd::getpid();
+    // SAFETY: the closure runs between fork and exec and only makes async-signal-safe system calls (prctl,
+    // getppid).
+    unsafe {
+        command.pre_exec(move || {
+            nix::sys::prctl::set_pdeathsig(Signal::SIGKILL).map_err(std::io::Error::from)?;
+            // A parent that died between fork and prctl sends no signal any more: the child must not start.
+            if nix::unistd::getppid() != parent {
+                return Err(std::io::Error::other(
+                    "the launcher died while starting this process",
+                ));
+            }
+            Ok(())
+        });
     }
+    command.spawn()
 }
 
 /// Sends `signal` to a child; a child that already exited is not an error.
