@@ -91,7 +91,8 @@ pub struct Explorer {
     tick: u64,
     position: V2,
     to_coordinator: VecDeque<Letter<'static>>,
-    region: Option<(u32, V2, f32, Vec<f32>)>,
+    /// The newest node's region, to share.
+    region: Option<Lsr>,
     world_status_due: bool,
     world_status_sent: Option<u64>,
 }
@@ -186,12 +187,7 @@ impl Explorer {
             range,
             frame.tick,
         );
-        self.region = Some((
-            frame.tick.min(u64::from(u32::MAX)) as u32,
-            lsr.centre,
-            lsr.heading,
-            lsr.rays.clone(),
-        ));
+        self.region = Some(lsr);
         self.srt.arrive(lsr);
     }
 
@@ -404,7 +400,9 @@ impl Profile for Explorer {
             last_position: None,
             tick: 0,
             position: V2::ZERO,
-            to_coordinator: VecDeque::new(),
+            to_coordinator: VecDeque::with_capacity(
+                params.whole_or("max_tasks", DEFAULT_MAX_TASKS)? + 16,
+            ),
             region: None,
             world_status_due: true,
             world_status_sent: None,
@@ -450,14 +448,14 @@ impl Profile for Explorer {
                     }
                 }
                 Letter::Region(region) if mail.from != FROM_WORLD => {
-                    let rays: Vec<f32> = region.rays().collect();
-                    if self.others.len() < self.others.capacity() && !rays.is_empty() {
-                        self.others.push(Lsr {
-                            centre: region.centre,
-                            heading: region.heading,
-                            rays,
-                            time: u64::from(region.tick),
-                        });
+                    let lsr = Lsr::from_rays(
+                        region.centre,
+                        region.heading,
+                        region.rays(),
+                        u64::from(region.tick),
+                    );
+                    if self.others.len() < self.others.capacity() && !lsr.rays().is_empty() {
+                        self.others.push(lsr);
                     }
                 }
                 _ => {}
@@ -488,8 +486,9 @@ impl Profile for Explorer {
                 self.world_status_sent = Some(self.tick);
             }
         }
-        if let Some((tick, centre, heading, rays)) = &self.region {
-            let len = wire::encode_region(*tick, *centre, *heading, rays, &mut payload);
+        if let Some(lsr) = &self.region {
+            let tick = lsr.time.min(u64::from(u32::MAX)) as u32;
+            let len = wire::encode_region(tick, lsr.centre, lsr.heading, lsr.rays(), &mut payload);
             if post(Address::All, len, &payload, &mut budget) {
                 self.region = None;
             }

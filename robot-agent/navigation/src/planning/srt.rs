@@ -10,35 +10,55 @@ use rand::Rng;
 
 use crate::V2;
 
+/// Most rays a region keeps (the range finder's most).
+pub const MAX_RAYS: usize = 24;
+
 /// A local safe region: the centre and the ray lengths of a ring (ray k at `heading + 2 pi k / n`), each capped
-/// at the sensor's range, and when it was seen.
-#[derive(Debug, Clone, PartialEq)]
+/// at the sensor's range, and when it was seen. Fixed-size, so that robots can keep and exchange regions without
+/// allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lsr {
     /// Where the robot stood.
     pub centre: V2,
     /// The angle of ray 0.
     pub heading: f32,
-    /// The ray lengths.
-    pub rays: Vec<f32>,
     /// The time it was seen.
     pub time: u64,
+    rays: [f32; MAX_RAYS],
+    len: usize,
 }
 
 impl Lsr {
-    /// The LSR of a scan: infinite readings are capped at `range`.
+    /// The LSR of a scan: infinite readings are capped at `range`, and rays beyond [`MAX_RAYS`] are left out.
     pub fn new(centre: V2, heading: f32, ranges: &[f32], range: f32, time: u64) -> Lsr {
-        Lsr {
+        Lsr::from_rays(centre, heading, ranges.iter().map(|r| r.min(range)), time)
+    }
+
+    /// A region from its ray lengths as given (at most [`MAX_RAYS`] are kept).
+    pub fn from_rays(centre: V2, heading: f32, rays: impl Iterator<Item = f32>, time: u64) -> Lsr {
+        let mut lsr = Lsr {
             centre,
             heading,
-            rays: ranges.iter().map(|r| r.min(range)).collect(),
             time,
+            rays: [0.0; MAX_RAYS],
+            len: 0,
+        };
+        for (slot, ray) in lsr.rays.iter_mut().zip(rays) {
+            *slot = ray;
+            lsr.len += 1;
         }
+        lsr
+    }
+
+    /// The ray lengths.
+    pub fn rays(&self) -> &[f32] {
+        &self.rays[..self.len]
     }
 
     /// RAY(S, theta): the extent of the region in direction `angle`, the smaller of the two rays around it
     /// (conservative between rays).
     pub fn extent(&self, angle: f32) -> f32 {
-        let n = self.rays.len();
+        let n = self.len;
         if n == 0 {
             return 0.0;
         }
@@ -268,7 +288,7 @@ mod tests {
         assert_eq!(lsr.extent(0.3), 0.5);
         assert_eq!(lsr.extent(std::f32::consts::PI + 0.1), 0.8);
         assert!(lsr.contains(V2::new(0.4, 0.1)) && !lsr.contains(V2::new(0.6, 0.1)));
-        assert_eq!(lsr.rays[2], 2.0);
+        assert_eq!(lsr.rays()[2], 2.0);
     }
 
     #[test]
