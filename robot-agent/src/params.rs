@@ -34,6 +34,9 @@ pub enum ParamError {
     },
 }
 
+/// The largest capacity a parameter may ask for: the runtime's most participants.
+pub const MAX_CAPACITY: usize = 1 << 20;
+
 /// The attributes of a `<params>` element, in document order, and the run's seed.
 ///
 /// Every name a controller asks for is remembered (by every clone alike), so that after the controller is built
@@ -126,6 +129,21 @@ impl Params {
             value: raw.to_owned(),
             expected: "a whole number >= 0",
         })
+    }
+
+    /// `name` as a capacity (how much a controller keeps: robots, tasks, obstacles, regions) from 1 to
+    /// [`MAX_CAPACITY`], or `default` when absent: a controller reserves its memory up front, so an absurd value
+    /// must be an error, not an allocation that fails.
+    pub fn capacity_or(&self, name: &str, default: usize) -> Result<usize, ParamError> {
+        let count = self.whole_or(name, default)?;
+        if count == 0 || count > MAX_CAPACITY {
+            return Err(ParamError::OutOfRange {
+                name: name.to_owned(),
+                value: count.to_string(),
+                rule: "must be from 1 to 1048576",
+            });
+        }
+        Ok(count)
     }
 
     /// `name` as a finite `f32`, or `default` when absent.

@@ -102,17 +102,7 @@ impl ExplorationCoordinator {
     pub fn from_params(params: &Params) -> Result<Self, ParamError> {
         let d = FgaParams::default();
         let w = Weights::default();
-        let positive_whole = |name: &str, default: usize| -> Result<usize, ParamError> {
-            let v = params.whole_or(name, default)?;
-            if v == 0 {
-                return Err(ParamError::Malformed {
-                    name: name.into(),
-                    value: "0".into(),
-                    expected: "a whole number above 0",
-                });
-            }
-            Ok(v)
-        };
+        let positive_whole = |name: &str, default: usize| params.capacity_or(name, default);
         Ok(Self {
             fga: FgaParams {
                 population: positive_whole("population", d.population)?.max(2),
@@ -648,6 +638,16 @@ mod tests {
         assert!(
             told.iter()
                 .any(|(to, l)| *to == Address::To(2) && *l == Letter::Done(1))
+        );
+    }
+
+    #[test]
+    fn capacities_are_bounded() {
+        let params = Params::new([("max_robots", "1000000000000")]);
+        let err = ExplorationCoordinator::from_params(&params).unwrap_err();
+        assert!(
+            err.to_string().contains("must be from 1 to 1048576"),
+            "{err}"
         );
     }
 

@@ -51,7 +51,7 @@ impl NavigationCoordinator {
                 });
             }
         };
-        let capacity = params.whole_or("max_robots", 1024usize)?.max(1);
+        let capacity = params.capacity_or("max_robots", 1024)?;
         Ok(Self {
             priority,
             stale: params.whole_or("stale", crate::profiles::navigation::DEFAULT_STALE_TICKS)?,

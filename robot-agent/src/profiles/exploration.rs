@@ -363,6 +363,10 @@ impl Profile for Explorer {
         let b = BugParams::default();
         let p = Pursuit::default();
         let clearance = params.positive_f32_or("clearance", b.clearance)?;
+        // Task numbers are 16 bits: more could never be told apart.
+        let max_tasks = params
+            .capacity_or("max_tasks", DEFAULT_MAX_TASKS)?
+            .min(wire::MAX_TASKS);
         Ok(Explorer {
             srt_params: SrtParams {
                 alpha: params.unit_f32_or("alpha", d.alpha)?,
@@ -385,8 +389,8 @@ impl Profile for Explorer {
             rng: None,
             setup: None,
             coordinator: None,
-            known: Vec::with_capacity(params.whole_or("max_tasks", DEFAULT_MAX_TASKS)?),
-            others: Vec::with_capacity(params.whole_or("max_regions", DEFAULT_MAX_REGIONS)?),
+            known: Vec::with_capacity(max_tasks),
+            others: Vec::with_capacity(params.capacity_or("max_regions", DEFAULT_MAX_REGIONS)?),
             srt: Srt::default(),
             heading: None,
             bug: Bug::new(),
@@ -400,9 +404,7 @@ impl Profile for Explorer {
             last_position: None,
             tick: 0,
             position: V2::ZERO,
-            to_coordinator: VecDeque::with_capacity(
-                params.whole_or("max_tasks", DEFAULT_MAX_TASKS)? + 16,
-            ),
+            to_coordinator: VecDeque::with_capacity(max_tasks + 16),
             region: None,
             world_status_due: true,
             world_status_sent: None,

@@ -190,8 +190,8 @@ impl Profile for Navigator {
     const TALKS: bool = true;
 
     fn from_params(params: &Params) -> Result<Self, ParamError> {
-        let robots = params.whole_or("max_robots", DEFAULT_CAPACITY)?.max(1);
-        let obstacles = params.whole_or("max_obstacles", DEFAULT_CAPACITY)?.max(1);
+        let robots = params.capacity_or("max_robots", DEFAULT_CAPACITY)?;
+        let obstacles = params.capacity_or("max_obstacles", DEFAULT_CAPACITY)?;
         Ok(Navigator {
             params: apf_params(params)?,
             stale: params.whole_or("stale", DEFAULT_STALE_TICKS)?,

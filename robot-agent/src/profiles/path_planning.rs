@@ -318,16 +318,14 @@ impl Profile for PathPlanner {
                 tolerance: params.non_negative_f32_or("tolerance", d.tolerance)?,
                 spacing: d.spacing,
                 linkage: params.non_negative_f32_or("linkage", d.linkage)?,
-                capacity: params.whole_or("max_hits", d.capacity)?,
+                capacity: params.capacity_or("max_hits", d.capacity)?,
                 max_radius: params.positive_f32_or("max_fit_radius", d.max_radius)?,
             },
             run_seed: params.run_seed(),
             offered: None,
             current: None,
             known: Assembly::with_capacity(
-                params
-                    .whole_or("max_obstacles", DEFAULT_MAX_OBSTACLES)?
-                    .max(1),
+                params.capacity_or("max_obstacles", DEFAULT_MAX_OBSTACLES)?,
             ),
             bounds: None,
             found: Discoveries::default(),

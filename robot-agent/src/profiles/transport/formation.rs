@@ -84,14 +84,17 @@ pub fn along(path: &[V2], start_angle: f32, goal_angle: f32) -> Vec<Pose> {
         .collect()
 }
 
+/// Most steps of a local path: tiny step parameters cannot make it unbounded.
+pub const MAX_STEPS: usize = 4096;
+
 /// The method's local path (`GENERATE_PATH`): from `start` to the goal in equal steps of at most `step` metres
-/// and `angle_step` radians, the pose interpolated linearly.
+/// and `angle_step` radians (at most [`MAX_STEPS`] steps), the pose interpolated linearly.
 pub fn straight(start: Pose, goal: V2, goal_angle: f32, step: f32, angle_step: f32) -> Vec<Pose> {
     let turn = wrap(goal_angle - start.angle);
     let distance = (goal - start.centre).length();
     let steps = ((distance / step).ceil())
         .max((turn.abs() / angle_step).ceil())
-        .max(1.0) as usize;
+        .clamp(1.0, MAX_STEPS as f32) as usize;
     (0..=steps)
         .map(|i| {
             let share = i as f32 / steps as f32;
@@ -155,5 +158,9 @@ mod tests {
         let line = straight(start, V2::new(2.0, 1.0), 0.5 + 1.0, 0.2, 0.1);
         assert_eq!(line.len(), 11, "10 steps: the turn needs more than the 1 m");
         assert!(close(line[10].centre, V2::new(2.0, 1.0)) && (line[10].angle - 1.5).abs() < 1e-5);
+        // A step of a micrometre still gives a bounded path that ends at the goal.
+        let fine = straight(start, V2::new(2.0, 1.0), 1.5, 1e-6, 1e-6);
+        assert_eq!(fine.len(), MAX_STEPS + 1);
+        assert!(close(fine[MAX_STEPS].centre, V2::new(2.0, 1.0)));
     }
 }
