@@ -2,8 +2,10 @@
 //!
 //! Whole system: ARGoS' obstacle-avoidance density (`density_N<N>.argos`: 50 e-pucks per 16 m², N/10 boxes and
 //! N/10 cylinders) with one agent process per robot, through the same launcher as `swarm run`, repeated; per N the
-//! medians of robot-steps per second, p50/p99 tick time (the world's own figures from summary.json), time to the
-//! first tick, each agent's peak RSS, and the CPU time the agents use per robot-step and the world per tick.
+//! medians of the whole run's wall time (what a user times: start-up and shut-down included), the time to the first
+//! tick and after the last one, robot-steps per second and p50/p99 tick time while ticking (the world's own
+//! figures from summary.json), each agent's peak RSS, and the CPU time the agents use per robot-step and the world
+//! per tick.
 //! Bare: the lockstep round trip with no world work and no player ([`bare`]), next to the same-hour floor of a
 //! minimal futex-broadcast lockstep ([`floor`]). Real time: one paced run (e.g. 2,000 agents at 10 ticks/s) and
 //! whether every tick kept its slot.
@@ -70,6 +72,11 @@ pub struct SystemFigures {
     pub tick_p99_us: f64,
     /// Seconds from starting the world to the end of the first tick.
     pub first_tick_seconds: f64,
+    /// Median over the runs of the whole run's wall time, start-up and shut-down included: what a user times.
+    pub wall_seconds: f64,
+    /// Median over the runs of the seconds from the end of the last tick to the end of the run (records
+    /// flushed, every process gone).
+    pub after_last_tick_seconds: f64,
     /// Median over agents of their peak RSS, in KiB.
     pub agent_peak_rss_kib_median: f64,
     /// Largest agent peak RSS, in KiB.
@@ -312,6 +319,8 @@ fn system(
     let mut p50s = Vec::new();
     let mut p99s = Vec::new();
     let mut first_ticks = Vec::new();
+    let mut walls = Vec::new();
+    let mut afters = Vec::new();
     let mut rss = Vec::new();
     let mut agents_cpu = Vec::new();
     let mut world_cpu = Vec::new();
@@ -322,11 +331,12 @@ fn system(
         rates.push(figure(&summary, "robot_steps_per_second", &summary_path)?);
         p50s.push(figure(&summary, "tick_micros_p50", &summary_path)?);
         p99s.push(figure(&summary, "tick_micros_p99", &summary_path)?);
-        first_ticks.push(figure(
-            &summary,
-            "time_to_first_tick_seconds",
-            &summary_path,
-        )?);
+        let first_tick = figure(&summary, "time_to_first_tick_seconds", &summary_path)?;
+        let wall = figure(&summary, "wall_seconds", &summary_path)?;
+        let ticking = figure(&summary, "ticking_seconds", &summary_path)?;
+        first_ticks.push(first_tick);
+        walls.push(wall);
+        afters.push((wall - first_tick - ticking).max(0.0));
         agents_cpu.push(figure(
             &summary,
             "cpu_agents_us_per_robot_step",
@@ -344,6 +354,8 @@ fn system(
         tick_p50_us: median(&p50s).unwrap_or(0.0),
         tick_p99_us: median(&p99s).unwrap_or(0.0),
         first_tick_seconds: median(&first_ticks).unwrap_or(0.0),
+        wall_seconds: median(&walls).unwrap_or(0.0),
+        after_last_tick_seconds: median(&afters).unwrap_or(0.0),
         agent_peak_rss_kib_median: median(&rss).unwrap_or(0.0),
         agent_peak_rss_kib_max: rss.iter().copied().fold(0.0, f64::max),
         cpu_agents_us_per_robot_step: median(&agents_cpu).unwrap_or(0.0),
@@ -376,19 +388,23 @@ pub fn markdown(report: &BenchReport) -> String {
     let mut text = String::new();
     if !report.system.is_empty() {
         text.push_str(
-            "| N | runs x ticks | robot-steps/s (median) | tick p50 | tick p99 | first tick | agent peak RSS (median / max) \
-             | agent CPU per robot-step | world CPU per tick |\n|---|---|---|---|---|---|---|---|---|\n",
+            "| N | runs x ticks | whole run | first tick | after the last tick | robot-steps/s (median) | tick p50 | tick p99 \
+             | agent peak RSS (median / max) | agent CPU per robot-step | world CPU per tick |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for f in &report.system {
             text.push_str(&format!(
-                "| {} | {} x {} | {:.0} | {:.0} µs | {:.0} µs | {:.2} s | {:.1} / {:.1} MiB | {:.1} µs | {:.0} µs |\n",
+                "| {} | {} x {} | {:.2} s | {:.2} s | {:.2} s | {:.0} | {:.0} µs | {:.0} µs | {:.1} / {:.1} MiB | {:.1} µs \
+                 | {:.0} µs |\n",
                 f.robots,
                 f.runs,
                 f.ticks,
+                f.wall_seconds,
+                f.first_tick_seconds,
+                f.after_last_tick_seconds,
                 f.robot_steps_per_second,
                 f.tick_p50_us,
                 f.tick_p99_us,
-                f.first_tick_seconds,
                 f.agent_peak_rss_kib_median / 1024.0,
                 f.agent_peak_rss_kib_max / 1024.0,
                 f.cpu_agents_us_per_robot_step,
