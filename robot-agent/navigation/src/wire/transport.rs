@@ -54,6 +54,25 @@ pub struct Object {
     pub plans: u32,
 }
 
+/// The outward normal of face `face` ([`Object::face`]) in the box's own frame: 0 +x, 1 +y, 2 -x, 3 -y.
+pub fn face_normal(face: u8) -> V2 {
+    match face % 4 {
+        0 => V2::new(1.0, 0.0),
+        1 => V2::new(0.0, 1.0),
+        2 => V2::new(-1.0, 0.0),
+        _ => V2::new(0.0, -1.0),
+    }
+}
+
+/// The distance from the centre of a box of half size `half` to its face `face`.
+pub fn face_distance(half: V2, face: u8) -> f32 {
+    if face.is_multiple_of(2) {
+        half.x
+    } else {
+        half.y
+    }
+}
+
 /// Part of the box's path: `points` from `first` of a whole of `total`, for plan number `plan`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathChunk<'a> {

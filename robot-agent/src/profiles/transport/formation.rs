@@ -3,7 +3,7 @@
 
 use swarm_navigation::V2;
 use swarm_navigation::vec2::wrap;
-use swarm_navigation::wire::transport::Object;
+use swarm_navigation::wire::transport::{Object, face_distance, face_normal};
 
 /// A pose of the box: its centre and heading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,36 +17,12 @@ pub struct Pose {
 impl Pose {
     /// `local`, a point of the box's own frame, in the world.
     pub fn to_world(self, local: V2) -> V2 {
-        self.centre + rotate(local, self.angle)
+        self.centre + local.rotated(self.angle)
     }
 
     /// `world`, a point of the world, in the box's own frame.
     pub fn to_local(self, world: V2) -> V2 {
-        rotate(world - self.centre, -self.angle)
-    }
-}
-
-fn rotate(v: V2, angle: f32) -> V2 {
-    let (s, c) = angle.sin_cos();
-    V2::new(c * v.x - s * v.y, s * v.x + c * v.y)
-}
-
-/// The outward normal of `face` in the box's frame: 0 +x, 1 +y, 2 -x, 3 -y.
-fn normal(face: u8) -> V2 {
-    match face % 4 {
-        0 => V2::new(1.0, 0.0),
-        1 => V2::new(0.0, 1.0),
-        2 => V2::new(-1.0, 0.0),
-        _ => V2::new(0.0, -1.0),
-    }
-}
-
-/// The distance from the box's centre to `face`.
-fn face_distance(half: V2, face: u8) -> f32 {
-    if face.is_multiple_of(2) {
-        half.x
-    } else {
-        half.y
+        (world - self.centre).rotated(-self.angle)
     }
 }
 
@@ -57,7 +33,7 @@ pub fn face_point(object: &Object, radius: f32, beyond: f32) -> (V2, f32) {
         centre: object.centre,
         angle: object.angle,
     };
-    let n = normal(object.face);
+    let n = face_normal(object.face);
     let out = n * (face_distance(object.half, object.face) + radius + beyond);
     let point = pose.to_world(out);
     (point, (pose.centre - point).angle())

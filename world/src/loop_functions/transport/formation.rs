@@ -7,6 +7,7 @@
 //! front, then the last one.
 
 use swarm_navigation::V2;
+use swarm_navigation::wire::transport::{face_distance, face_normal};
 
 /// Faces of a box: the most robots a team can have.
 pub(super) const FACES: usize = 4;
@@ -15,17 +16,12 @@ pub(super) const FACES: usize = 4;
 pub(super) fn front_face(angle: f32, towards: V2) -> u8 {
     let mut best = (0, f32::NEG_INFINITY);
     for face in 0..FACES as u8 {
-        let along = normal(angle, face).dot(towards);
+        let along = face_normal(face).rotated(angle).dot(towards);
         if along > best.1 {
             best = (face, along);
         }
     }
     best.0
-}
-
-/// The outward normal of `face` of a box at heading `angle`.
-fn normal(angle: f32, face: u8) -> V2 {
-    V2::from_angle(angle + f32::from(face) * std::f32::consts::FRAC_PI_2)
 }
 
 /// The faces of the robots of rank 0, 1, ... (at most [`FACES`]) with the front face `front`: the front, the
@@ -36,15 +32,6 @@ pub(super) fn faces(front: u8, team: usize) -> Vec<u8> {
         .take(team)
         .map(|turn| (front + turn) % FACES as u8)
         .collect()
-}
-
-/// Distance from the centre of a box of half size `half` to its `face`.
-fn face_distance(half: V2, face: u8) -> f32 {
-    if face.is_multiple_of(2) {
-        half.x
-    } else {
-        half.y
-    }
 }
 
 /// The formation's radius: the larger of the box's half-diagonal and, over the faces in use, the distance from
