@@ -37,7 +37,7 @@
 //!   removed) forgets what it sensed and loses its waiting letters: back in the run it senses anew.
 //! - **Execution.** Robots send the world a `Status` when their mode changes and every second. A task is in
 //!   progress in a tick when the present, living robots within `reach` of it that declare `Execute` with it
-//!   include a feasible team by the world's types (`swarm_allocation::team::feasible`); the team recorded is
+//!   include a feasible team by the world's types (`swarm_allocation::team::includes_feasible`); the team recorded is
 //!   all those robots. Progress counts the ticks in progress and starts again from zero after a tick that is
 //!   not. After `task_time` ticks the task is complete, with utility
 //!   `wire::exploration::utility_at(value, window, decay, tick)`; robots travelling to or executing it, and any
@@ -73,7 +73,7 @@ use std::fmt::Write as _;
 
 use serde_json::json;
 use swarm_allocation::Kind;
-use swarm_allocation::team::feasible;
+use swarm_allocation::team::includes_feasible;
 use swarm_contract::mail::{Address, FROM_WORLD, Mail};
 use swarm_contract::messages::ActuatorCommand;
 use swarm_navigation::V2;
@@ -167,16 +167,6 @@ impl Member {
         self.mode = Mode::Explore;
         self.task = None;
     }
-}
-
-/// Whether robots with `ones` type-1 and `twos` type-2 members include a feasible team for a task of `kind`.
-fn includes_feasible_team(kind: Kind, ones: usize, twos: usize) -> bool {
-    use Kind::{One, Two};
-    (ones >= 1 && feasible(kind, &[One]))
-        || (twos >= 1 && feasible(kind, &[Two]))
-        || (ones >= 2 && feasible(kind, &[One, One]))
-        || (ones >= 1 && twos >= 1 && (feasible(kind, &[One, Two]) || feasible(kind, &[Two, One])))
-        || (twos >= 2 && feasible(kind, &[Two, Two]))
 }
 
 /// The sum of `values` from +0 (`Iterator::sum` of floats starts from -0, which an empty sum would show).
@@ -362,7 +352,7 @@ impl Exploration {
         for (n, task) in self.tasks.iter().enumerate() {
             let p = task.spec.position;
             let at = format!("task {n} at ({}, {})", p.x, p.y);
-            if !includes_feasible_team(task.spec.kind, ones, twos) {
+            if !includes_feasible(task.spec.kind, ones, twos) {
                 return Err(self.error(format!(
                     "{at} is of type {}, which no team of this swarm can do: it needs one type-2 robot or two \
                      type-1 robots, and the swarm has {twos} type-2 and {ones} type-1",
@@ -505,7 +495,7 @@ impl Exploration {
                 .iter()
                 .filter(|&&(_, i)| self.robots[i].kind == Kind::One)
                 .count();
-            if !includes_feasible_team(task.spec.kind, ones, team.len() - ones) {
+            if !includes_feasible(task.spec.kind, ones, team.len() - ones) {
                 task.progress = 0;
                 continue;
             }
