@@ -109,19 +109,9 @@ impl<'a> ParamReader<'a> {
         let Some(raw) = self.raw(name) else {
             return Ok(None);
         };
-        let invalid = || self.invalid(name, raw, &format!("{N} numbers separated by `,`"));
-        let mut parts = raw.split(',');
-        let mut out = [0.0; N];
-        for slot in &mut out {
-            match parts.next().map(|v| v.trim().parse::<f64>()) {
-                Some(Ok(v)) if v.is_finite() => *slot = v,
-                _ => return Err(invalid()),
-            }
-        }
-        if parts.next().is_some() {
-            return Err(invalid());
-        }
-        Ok(Some(out))
+        finite_numbers(raw)
+            .map(Some)
+            .ok_or_else(|| self.invalid(name, raw, &format!("{N} numbers separated by `,`")))
     }
 
     /// Attribute `name`, which must be one of `choices`, or `default` when absent.
@@ -148,13 +138,9 @@ impl<'a> ParamReader<'a> {
         };
         raw.split(';')
             .map(|point| {
-                let mut xy = point.split(',').map(|v| v.trim().parse::<f64>());
-                match (xy.next(), xy.next(), xy.next()) {
-                    (Some(Ok(x)), Some(Ok(y)), None) if x.is_finite() && y.is_finite() => {
-                        Ok((x, y))
-                    }
-                    _ => Err(self.invalid(name, raw, "points `x,y` separated by `;`")),
-                }
+                finite_numbers::<2>(point)
+                    .map(|[x, y]| (x, y))
+                    .ok_or_else(|| self.invalid(name, raw, "points `x,y` separated by `;`"))
             })
             .collect::<Result<Vec<_>, _>>()
             .map(Some)
@@ -214,6 +200,21 @@ impl<'a> ParamReader<'a> {
             message: format!("<{} {name}=\"{raw}\">: must be {expected}", self.element),
         }
     }
+}
+
+/// Exactly `N` finite numbers separated by commas, or `None`.
+fn finite_numbers<const N: usize>(text: &str) -> Option<[f64; N]> {
+    let mut parts = text.split(',');
+    let mut out = [0.0; N];
+    for slot in &mut out {
+        *slot = parts
+            .next()?
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())?;
+    }
+    parts.next().is_none().then_some(out)
 }
 
 #[cfg(test)]
