@@ -301,7 +301,6 @@ fn explore(s: &mut Explorer, frame: &SensorFrame, command: &mut ActuatorCommand)
         s.srt = Srt::default();
         s.heading = None;
     }
-    s.srt_params.memory = (s.memory_seconds * setup.ticks_per_second as f32).round() as u64;
     s.forget(frame.tick);
     let here = Explorer::position(frame);
     if s.srt.regions().next().is_none() {
@@ -418,7 +417,11 @@ impl Profile for Explorer {
             };
             let from_coordinator = self.coordinator == Some(mail.from);
             match letter {
-                Letter::Setup(setup) if mail.from == FROM_WORLD => self.setup = Some(setup),
+                Letter::Setup(setup) if mail.from == FROM_WORLD => {
+                    self.srt_params.memory =
+                        (self.memory_seconds * setup.ticks_per_second as f32).round() as u64;
+                    self.setup = Some(setup);
+                }
                 Letter::Found(found) if mail.from == FROM_WORLD => self.learn(found),
                 Letter::Done(task) if mail.from == FROM_WORLD || from_coordinator => {
                     if let Some(known) = self.known.iter().find(|f| f.task == task).copied() {
@@ -481,12 +484,19 @@ impl Profile for Explorer {
             || self
                 .world_status_sent
                 .is_none_or(|sent| self.tick >= sent + ticks_per_second);
-        if world_due {
-            let len = wire::encode_status(&status, &mut payload);
-            if post(Address::To(TO_WORLD), len, &payload, &mut budget) {
-                self.world_status_due = false;
-                self.world_status_sent = Some(self.tick);
-            }
+        // The same status goes to the world and to the coordinator: encoded once.
+        let mut status_payload = [0u8; PAYLOAD];
+        let status_len = wire::encode_status(&status, &mut status_payload);
+        if world_due
+            && post(
+                Address::To(TO_WORLD),
+                status_len,
+                &status_payload,
+                &mut budget,
+            )
+        {
+            self.world_status_due = false;
+            self.world_status_sent = Some(self.tick);
         }
         if let Some(lsr) = &self.region {
             let tick = lsr.time.min(u64::from(u32::MAX)) as u32;
@@ -499,8 +509,7 @@ impl Profile for Explorer {
             return;
         };
         let to = Address::To(coordinator);
-        let len = wire::encode_status(&status, &mut payload);
-        post(to, len, &payload, &mut budget);
+        post(to, status_len, &status_payload, &mut budget);
         while let Some(letter) = self.to_coordinator.front() {
             let len = match letter {
                 Letter::Found(found) => wire::encode_found(found, &mut payload),

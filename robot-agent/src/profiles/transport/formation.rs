@@ -60,7 +60,8 @@ pub fn along(path: &[V2], start_angle: f32, goal_angle: f32) -> Vec<Pose> {
         .collect()
 }
 
-/// Most steps of a local path: tiny step parameters cannot make it unbounded.
+/// Most steps of a path a robot keeps (a local path's, a global path's points less one): tiny step parameters
+/// or a long path cannot make it unbounded.
 pub const MAX_STEPS: usize = 4096;
 
 /// The method's local path (`GENERATE_PATH`): from `start` to the goal in equal steps of at most `step` metres

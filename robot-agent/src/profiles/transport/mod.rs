@@ -47,7 +47,7 @@ use swarm_navigation::wire::transport::{self as wire, Ending, Letter, Object, Ou
 
 use crate::params::{ParamError, Params};
 use crate::profile::{Procedure, Profile};
-use formation::{Pose, along, face_point, straight};
+use formation::{MAX_STEPS, Pose, along, face_point, straight};
 use protocol::{PathMode, Team, Timing};
 
 /// The foot-bot's radius (m).
@@ -56,8 +56,6 @@ const FOOTBOT_RADIUS: f32 = 0.085_036_76;
 const GRIP_GAP: f32 = 0.005;
 /// Ticks a robot that should hold a lifted box may see it not lifted before it calls the box dropped.
 const DROP_TICKS: u32 = 5;
-/// Most points of a path kept.
-const MAX_PATH: usize = 4096;
 /// Waypoints over which a shift of the path fades out.
 const SHIFT_FADE: u32 = 5;
 /// Heading error under which a robot at its standoff point stops turning and creeps in (rad).
@@ -570,7 +568,7 @@ impl Profile for Carrier {
                     if chunk.plan != self.incoming.plan || chunk.first == 0 {
                         self.incoming = Incoming {
                             plan: chunk.plan,
-                            total: usize::from(chunk.total).min(MAX_PATH),
+                            total: usize::from(chunk.total).min(MAX_STEPS + 1),
                             points: Vec::new(),
                         };
                     }
