@@ -20,6 +20,11 @@ pub const TRAJECTORY_FILE: &str = "trajectory.csv";
 pub const EVENTS_FILE: &str = "events.csv";
 /// Every addressed message's fate (runs with a `<messages>` medium).
 pub const MESSAGES_FILE: &str = "messages.csv";
+/// What does not move with the robots: the arena, obstacles, targets and lights as placed, each robot's id,
+/// controller and body (`swarm view` draws the run over it).
+pub const SCENE_FILE: &str = "scene.json";
+/// The floor's grey levels as an image over the arena (runs whose floor is not all white).
+pub const FLOOR_IMAGE_FILE: &str = "floor.png";
 /// Each controller's event names by id, for the world's `events.csv`.
 pub const EVENT_TABLES_FILE: &str = "event_tables.json";
 /// The configuration as the run used it.

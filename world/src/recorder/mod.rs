@@ -1,6 +1,6 @@
 //! The run record: `trajectory.csv` (one row per robot per tick), `events.csv` (every fired event and fault),
-//! `messages.csv` (every addressed message's fate, in runs with a messages medium),
-//! `summary.json` (the loop functions' metrics and run facts) and PNG snapshots at chosen ticks.
+//! `messages.csv` (every addressed message's fate, in runs with a messages medium), `scene.json` (what a viewer
+//! draws the run over, [`scene_file`]), `summary.json` (the loop functions' metrics and run facts) and PNG snapshots at chosen ticks.
 //!
 //! The tick loop only copies plain rows; a thread of the recorder's own formats, writes and flushes them, one
 //! batch per tick ([`background`], [`files`]). Recording reads the world and never changes it.
@@ -10,6 +10,7 @@ mod csv_line;
 pub mod events;
 pub mod files;
 pub mod messages;
+pub mod scene_file;
 pub mod snapshot;
 pub mod trails;
 pub mod trajectory;
@@ -80,6 +81,7 @@ impl Recorder {
                 .then(|| messages::MessagesWriter::create(dir))
                 .transpose()?,
         };
+        scene_file::write(dir, world)?;
         let loop_output = match world.loop_output_name() {
             None => None,
             Some(name) => {
