@@ -9,4 +9,5 @@
 
 pub mod bench;
 pub mod experiment;
+pub mod export;
 pub mod launcher;

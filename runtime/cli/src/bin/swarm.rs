@@ -13,10 +13,12 @@
 //! `swarm experiment <grid.toml>` runs a grid of configurations x seeds into a batch folder (`docs/experiments.md`):
 //! several runs at once, resumable, with `results.csv`, figures and `report.md`.
 
+use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::time::Duration;
 
 use anyhow::Context;
@@ -100,6 +102,42 @@ enum Commands {
         /// Hosts to run the robots on.
         #[command(flatten)]
         hosts: HostsArgs,
+        /// Watch the run live in the browser: serve the viewer (the same page as `swarm view`) while the run
+        /// goes on, and after it until Ctrl-C. The URL is printed when the run directory exists.
+        #[arg(long)]
+        view: bool,
+        /// Port of the live viewer (default: any free port).
+        #[arg(long, value_name = "PORT", requires = "view", default_value_t = 0)]
+        view_port: u16,
+        /// Address the live viewer listens on (default 127.0.0.1: this machine only).
+        #[arg(
+            long,
+            value_name = "IP",
+            requires = "view",
+            default_value = "127.0.0.1"
+        )]
+        view_bind: IpAddr,
+    },
+    /// Convert a run's record files (trajectory, events, messages) to Apache Parquet beside the CSV files, for
+    /// pandas and polars (`pd.read_parquet`), or back to CSV (docs/records.md).
+    Export {
+        /// The run directory.
+        run: PathBuf,
+        /// The format to write.
+        #[arg(long, value_enum)]
+        format: swarm_cli::export::Format,
+    },
+    /// Replay a run in the browser: serves a local web page of the run directory and prints its URL; Ctrl-C
+    /// stops it (docs/viewer.md).
+    View {
+        /// The run directory (a `swarm run --out`, or a run of an experiment batch).
+        run: PathBuf,
+        /// Port to serve on (default: any free port).
+        #[arg(long, default_value_t = 0)]
+        port: u16,
+        /// Address to listen on (default 127.0.0.1: this machine only).
+        #[arg(long, default_value = "127.0.0.1")]
+        bind: IpAddr,
     },
     /// Drive a live run from another terminal: list its robots, kill, freeze or thaw one.
     Ctl {
@@ -359,11 +397,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             real_time,
             faults,
             hosts,
+            view,
+            view_port,
+            view_bind,
         } => {
             let stop = Arc::new(AtomicBool::new(false));
-            let flag = Arc::clone(&stop);
-            ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-                .context("installing the Ctrl-C handler")?;
+            let interrupts = interrupt_channel(&stop)?;
             let options = RunOptions {
                 config: config.clone(),
                 robots,
@@ -387,6 +426,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 real_time,
                 faults,
                 hosts,
+                view: view.then_some(SocketAddr::new(view_bind, view_port)),
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;
@@ -412,16 +452,53 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 report.alive_final,
                 report.out_dir.display()
             );
-            Ok(if report.interrupted {
-                ExitCode::from(INTERRUPTED)
-            } else {
-                ExitCode::SUCCESS
-            })
+            if report.interrupted {
+                return Ok(ExitCode::from(INTERRUPTED));
+            }
+            if view {
+                println!("the run is over; its viewer stays up until Ctrl-C");
+                // Either a Ctrl-C or the handler's end: both mean stop serving.
+                let _ = interrupts.recv();
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Commands::Export { run, format } => {
+            let report = swarm_cli::export::export(&run, format)
+                .with_context(|| format!("exporting {} as {format}", run.display()))?;
+            for file in &report.files {
+                println!("{file}");
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Commands::View { run, port, bind } => {
+            let stop = Arc::new(AtomicBool::new(false));
+            let interrupts = interrupt_channel(&stop)?;
+            let viewer = swarm_viewer::Viewer::start(&run, false, bind, port)
+                .with_context(|| format!("viewing {}", run.display()))?;
+            println!(
+                "viewer of {}: {} (Ctrl-C stops it)",
+                run.display(),
+                viewer.url()
+            );
+            let _ = interrupts.recv();
+            Ok(ExitCode::from(INTERRUPTED))
         }
         Commands::Ctl { run, request } => done(ctl(&run, request)),
         Commands::Host(cli) => done(run_host(cli)),
         Commands::HostKey { names, dir } => done(host_key(&names, dir)),
     }
+}
+
+/// Installs the Ctrl-C (and SIGTERM) handler: it sets `stop` and sends on the returned channel.
+fn interrupt_channel(stop: &Arc<AtomicBool>) -> anyhow::Result<mpsc::Receiver<()>> {
+    let flag = Arc::clone(stop);
+    let (sender, receiver) = mpsc::sync_channel(1);
+    ctrlc::set_handler(move || {
+        flag.store(true, Ordering::Relaxed);
+        let _ = sender.try_send(());
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(receiver)
 }
 
 /// `swarm ctl`: one request to a live run, its answer on standard output.

@@ -27,6 +27,7 @@ pub mod restart;
 
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, IsTerminal, Write};
+use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::process::{ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::Arc;
@@ -88,6 +89,9 @@ pub struct RunOptions {
     pub faults: Vec<String>,
     /// Hosts to run the robots on instead of locally (see [`swarm_remote::plan`]).
     pub hosts: HostsArgs,
+    /// Serve the live viewer of the run at this address (`swarm run --view`); its URL is printed as soon as
+    /// the run directory exists.
+    pub view: Option<SocketAddr>,
 }
 
 /// What a finished run reports.
@@ -178,6 +182,9 @@ pub enum LaunchError {
     /// The run directory cannot be used.
     #[error(transparent)]
     RunDir(#[from] RunDirError),
+    /// The live viewer cannot be served.
+    #[error("--view: {0}")]
+    Viewer(#[from] swarm_viewer::ViewerError),
     /// A file or process operation failed.
     #[error("{what}: {source}")]
     Io {
@@ -290,6 +297,10 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         DiskBudget::new(&out_dir, limits.disk_reserve_mb, limits.records_max_mb).check()
     {
         return Err(LaunchError::NoRoom(reason));
+    }
+    if let Some(address) = options.view {
+        let viewer = swarm_viewer::Viewer::start(&out_dir, true, address.ip(), address.port())?;
+        println!("viewer: {}", viewer.url());
     }
     let binaries = Binaries::locate()?;
     RunSpec::remove_dead_runs();

@@ -1,0 +1,276 @@
+//! `events.csv` held per participant in a compact form (tick and an interned name, 12 bytes a row), with what
+//! the viewer derives from it: the faults, joins and leaves of the timeline, and when each robot was frozen or
+//! held something in its gripper. The index grows as the file does (a live run).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::lines::GrowingLines;
+
+/// The header this version writes (docs/records.md).
+pub const HEADER: &str = "tick,robot,robot_id,event";
+/// Timeline markers kept at most; a run with more faults and joins than this shows the first ones.
+pub const MAX_MARKERS: usize = 5000;
+/// Participant indices accepted at most when the scene does not say how many there are.
+const MAX_PARTICIPANTS: usize = 1 << 20;
+/// Distinct event names at most (they are interned as `u16`).
+const MAX_NAMES: usize = u16::MAX as usize;
+
+/// A fault, join or leave on the timeline.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Marker {
+    /// The tick.
+    pub tick: u64,
+    /// The participant index.
+    pub robot: usize,
+    /// Its id.
+    pub id: String,
+    /// `fault:kill`, `join`, ...
+    pub what: String,
+}
+
+/// A state that a robot enters and leaves, as (tick, now on) changes in tick order.
+#[derive(Default)]
+struct Toggles(Vec<(u64, bool)>);
+
+impl Toggles {
+    fn push(&mut self, tick: u64, on: bool) {
+        let at = self.0.partition_point(|&(t, _)| t <= tick);
+        self.0.insert(at, (tick, on));
+    }
+
+    fn at(&self, tick: u64) -> bool {
+        let at = self.0.partition_point(|&(t, _)| t <= tick);
+        at > 0 && self.0[at - 1].1
+    }
+}
+
+/// What one participant did.
+#[derive(Default)]
+struct Participant {
+    id: String,
+    /// (tick, interned event name), in file order (ticks ascending but for faults stamped ahead).
+    events: Vec<(u64, u16)>,
+    frozen: Toggles,
+    carrying: Toggles,
+}
+
+/// The events of one run.
+pub struct EventsIndex {
+    lines: GrowingLines,
+    table: Table,
+    problem: Option<String>,
+}
+
+struct Table {
+    header_seen: bool,
+    participants_limit: usize,
+    names: Vec<String>,
+    name_ids: HashMap<String, u16>,
+    participants: Vec<Participant>,
+    markers: Vec<Marker>,
+    markers_truncated: bool,
+}
+
+impl EventsIndex {
+    /// An index of the file at `path` of a run with `participants` robots and coordinators (`None`: unknown).
+    pub fn new(path: &Path, participants: Option<usize>) -> Self {
+        Self {
+            lines: GrowingLines::new(path),
+            table: Table {
+                header_seen: false,
+                participants_limit: participants.unwrap_or(MAX_PARTICIPANTS),
+                names: Vec::new(),
+                name_ids: HashMap::new(),
+                participants: Vec::new(),
+                markers: Vec::new(),
+                markers_truncated: false,
+            },
+            problem: None,
+        }
+    }
+
+    /// Why the file cannot be read further, if it cannot.
+    pub fn problem(&self) -> Option<&str> {
+        self.problem.as_deref()
+    }
+
+    /// Reads the rows written since the last call. Returns whether the file exists.
+    pub fn update(&mut self) -> bool {
+        if self.problem.is_some() {
+            return true;
+        }
+        let path = self.lines.path().display().to_string();
+        let (table, problem) = (&mut self.table, &mut self.problem);
+        let read = self.lines.read_new(|line| match table.add(line.text) {
+            Ok(()) => true,
+            Err(what) => {
+                *problem = Some(format!("{path}:{}: {what}", line.number));
+                false
+            }
+        });
+        match read {
+            Ok(exists) => exists,
+            Err(e) => {
+                self.problem = Some(format!("{path}: {e}"));
+                true
+            }
+        }
+    }
+
+    /// The faults, joins and leaves, and whether more were left out.
+    pub fn markers(&self) -> (&[Marker], bool) {
+        (&self.table.markers, self.table.markers_truncated)
+    }
+
+    /// Whether `robot` was frozen, and whether it held something in its gripper, at `tick`.
+    pub fn flags_at(&self, robot: usize, tick: u64) -> (bool, bool) {
+        self.table
+            .participants
+            .get(robot)
+            .map_or((false, false), |p| (p.frozen.at(tick), p.carrying.at(tick)))
+    }
+
+    /// `robot`'s events up to and including `tick`, as (tick, name), in file order.
+    pub fn events_until(&self, robot: usize, tick: u64) -> impl Iterator<Item = (u64, &str)> {
+        self.table
+            .participants
+            .get(robot)
+            .map(|p| p.events.as_slice())
+            .unwrap_or_default()
+            .iter()
+            .filter(move |&&(t, _)| t <= tick)
+            .map(|&(t, name)| (t, self.table.names[usize::from(name)].as_str()))
+    }
+}
+
+impl Table {
+    fn add(&mut self, text: &[u8]) -> Result<(), String> {
+        let text = std::str::from_utf8(text).map_err(|_| "the row is not UTF-8".to_owned())?;
+        if !self.header_seen {
+            if text != HEADER {
+                return Err(format!(
+                    "the header `{text}` is not the one this version writes (`{HEADER}`): the file is not an \
+                     events record, or an older version recorded it"
+                ));
+            }
+            self.header_seen = true;
+            return Ok(());
+        }
+        let mut fields = text.splitn(4, ',');
+        let mut next = |name: &str| {
+            fields
+                .next()
+                .ok_or_else(|| format!("the row ends before its `{name}` column"))
+        };
+        let tick_text = next("tick")?;
+        let tick: u64 = tick_text
+            .parse()
+            .map_err(|_| format!("`{tick_text}` in the `tick` column is not a tick"))?;
+        let robot_text = next("robot")?;
+        let robot: usize = robot_text
+            .parse()
+            .ok()
+            .filter(|&r| r < self.participants_limit)
+            .ok_or_else(|| {
+                format!("`{robot_text}` in the `robot` column is not a participant of this run")
+            })?;
+        let id = next("robot_id")?;
+        let event = next("event")?;
+        let name = self.intern(event)?;
+        if self.participants.len() <= robot {
+            self.participants
+                .resize_with(robot + 1, Participant::default);
+        }
+        let participant = &mut self.participants[robot];
+        if participant.id.is_empty() {
+            participant.id = id.to_owned();
+        }
+        participant.events.push((tick, name));
+        match event {
+            "fault:freeze" => participant.frozen.push(tick, true),
+            "fault:thaw" | "fault:up" => participant.frozen.push(tick, false),
+            "gripper:grip" => participant.carrying.push(tick, true),
+            "gripper:release" | "gripper:lost" | "gripper:release_on_death" => {
+                participant.carrying.push(tick, false)
+            }
+            _ => {}
+        }
+        if event.starts_with("fault:") || event.starts_with("join") || event == "leave" {
+            if self.markers.len() < MAX_MARKERS {
+                self.markers.push(Marker {
+                    tick,
+                    robot,
+                    id: id.to_owned(),
+                    what: event.to_owned(),
+                });
+            } else {
+                self.markers_truncated = true;
+            }
+        }
+        Ok(())
+    }
+
+    fn intern(&mut self, name: &str) -> Result<u16, String> {
+        if let Some(&id) = self.name_ids.get(name) {
+            return Ok(id);
+        }
+        if self.names.len() >= MAX_NAMES {
+            return Err(format!("more than {MAX_NAMES} distinct event names"));
+        }
+        let id = self.names.len() as u16;
+        self.names.push(name.to_owned());
+        self.name_ids.insert(name.to_owned(), id);
+        Ok(id)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derives_markers_and_frozen_spans() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("events.csv");
+        std::fs::write(
+            &path,
+            format!(
+                "{HEADER}\n1,0,ep0,go\n3,1,ep1,fault:freeze\n4,0,ep0,gripper:grip\n7,1,ep1,fault:thaw\n7,1,ep1,fault:up\n"
+            ),
+        )
+        .expect("written");
+        let mut index = EventsIndex::new(&path, Some(2));
+        assert!(index.update());
+        assert_eq!(index.problem(), None);
+        let (markers, truncated) = index.markers();
+        let whats: Vec<_> = markers.iter().map(|m| (m.tick, m.what.as_str())).collect();
+        assert_eq!(
+            whats,
+            vec![(3, "fault:freeze"), (7, "fault:thaw"), (7, "fault:up")]
+        );
+        assert!(!truncated);
+        assert_eq!(index.flags_at(1, 2), (false, false));
+        assert_eq!(index.flags_at(1, 3), (true, false));
+        assert_eq!(index.flags_at(1, 7), (false, false));
+        assert_eq!(index.flags_at(0, 5), (false, true));
+        let until: Vec<_> = index.events_until(0, 3).collect();
+        assert_eq!(until, vec![(1, "go")]);
+    }
+
+    #[test]
+    fn a_robot_outside_the_run_names_its_line() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("events.csv");
+        std::fs::write(&path, format!("{HEADER}\n1,0,ep0,go\n1,9,ep9,go\n")).expect("written");
+        let mut index = EventsIndex::new(&path, Some(2));
+        index.update();
+        let problem = index.problem().expect("a problem");
+        assert!(
+            problem.ends_with(
+                "events.csv:3: `9` in the `robot` column is not a participant of this run"
+            ),
+            "{problem}"
+        );
+    }
+}
