@@ -7,6 +7,8 @@
 
 #![warn(missing_docs)]
 
+pub mod browser;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
