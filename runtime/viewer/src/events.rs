@@ -157,7 +157,11 @@ impl Table {
             self.header_seen = true;
             return Ok(());
         }
-        let mut fields = text.splitn(4, ',');
+        // An event name holds no comma; an id from the configuration might, so the event is the last field.
+        let (front, event) = text
+            .rsplit_once(',')
+            .ok_or_else(|| "the row has no `event` column".to_owned())?;
+        let mut fields = front.splitn(3, ',');
         let mut next = |name: &str| {
             fields
                 .next()
@@ -176,7 +180,6 @@ impl Table {
                 format!("`{robot_text}` in the `robot` column is not a participant of this run")
             })?;
         let id = next("robot_id")?;
-        let event = next("event")?;
         let name = self.intern(event)?;
         if self.participants.len() <= robot {
             self.participants
@@ -256,6 +259,21 @@ mod tests {
         assert_eq!(index.flags_at(0, 5), (false, true));
         let until: Vec<_> = index.events_until(0, 3).collect();
         assert_eq!(until, vec![(1, "go")]);
+    }
+
+    #[test]
+    fn an_id_with_a_comma_keeps_its_event() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("events.csv");
+        std::fs::write(&path, format!("{HEADER}\n4,0,ep,0,fault:kill\n")).expect("written");
+        let mut index = EventsIndex::new(&path, Some(1));
+        index.update();
+        assert_eq!(index.problem(), None);
+        let (markers, _) = index.markers();
+        assert_eq!(
+            (markers[0].id.as_str(), markers[0].what.as_str()),
+            ("ep,0", "fault:kill")
+        );
     }
 
     #[test]

@@ -245,7 +245,8 @@ fn tick_and_robot(text: &[u8]) -> Result<(u64, usize), String> {
     Ok((tick, robot))
 }
 
-/// A row's robot index and pose. Ids hold no commas, so the columns are found by position.
+/// A row's robot index and pose: tick and robot from the left, the seven numbers from the right, so that an id
+/// with a comma in it (the configuration does not forbid one) is read right too.
 fn parse_row(text: &[u8]) -> Result<(usize, Pose), String> {
     let text = std::str::from_utf8(text).map_err(|_| "the row is not UTF-8".to_owned())?;
     let mut left = text.splitn(3, ',');

@@ -4,7 +4,7 @@
 //! (shortest float digits by Grisu, padding, one adapter call per piece) took about 1.3 µs per row at N = 1,000,
 //! more than a quarter of the world process's CPU. `itoa` and `ryu` format into stack buffers, and the pieces go
 //! into the `BufWriter` as byte slices. Floats are written in `ryu`'s shortest round-trip form (`1.0`, `0.25`,
-//! `1.5E-7`), which every CSV reader parses.
+//! `1.5e-7`), which every CSV reader parses.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
