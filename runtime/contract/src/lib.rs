@@ -25,6 +25,7 @@ pub mod config;
 pub mod cpu;
 pub mod disk_budget;
 pub mod fault_plan;
+pub mod fonts;
 pub mod limits;
 pub mod logging;
 pub mod mail;

@@ -4,15 +4,16 @@
 //! shows the spread over its seeds: a thin bar from the smallest to the largest run, a thick one over the middle
 //! half (first to third quartile), so a median that hides a wide spread is seen as such.
 //!
-//! Text is drawn with a TrueType font read once at run time (`SWARM_PLOT_FONT`, else a common system font), so
-//! the build needs no font library; without a font the batch still writes its table and report and says why the
-//! figures are missing.
+//! Text is drawn with the TrueType font of [`swarm_contract::fonts`] (`SWARM_FONT`, else a common system font),
+//! read once at run time, so the build needs no font library; without a font the batch still writes its table and
+//! report and says why the figures are missing.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use plotters::prelude::*;
+use swarm_contract::fonts::{self, NoFont};
 
 use super::grid::Grid;
 use super::plan::{Configuration, file_safe};
@@ -20,14 +21,6 @@ use super::results::{ConfigResult, RunResult};
 
 /// The font family name the figures use.
 const FAMILY: &str = "sans-serif";
-/// Fonts tried in order when `SWARM_PLOT_FONT` is not set.
-const FONT_CANDIDATES: &[&str] = &[
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation2/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-];
 /// Figure size in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
@@ -71,14 +64,8 @@ pub struct Figure {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum PlotError {
     /// No usable font.
-    #[error(
-        "no font to draw figures with: set SWARM_PLOT_FONT to a .ttf file or install one (e.g. Debian's \
-         fonts-dejavu-core); tried {tried}"
-    )]
-    NoFont {
-        /// The files tried.
-        tried: String,
-    },
+    #[error("cannot draw figures: {0}")]
+    NoFont(NoFont),
     /// Drawing or writing a figure failed.
     #[error("{path}: {reason}")]
     Draw {
@@ -93,28 +80,11 @@ pub enum PlotError {
 fn font() -> Result<(), PlotError> {
     static FONT: OnceLock<Result<(), PlotError>> = OnceLock::new();
     FONT.get_or_init(|| {
-        let candidates: Vec<PathBuf> = std::env::var_os("SWARM_PLOT_FONT")
-            .map(PathBuf::from)
-            .into_iter()
-            .chain(FONT_CANDIDATES.iter().map(PathBuf::from))
-            .collect();
-        for path in &candidates {
-            let Ok(bytes) = std::fs::read(path) else {
-                continue;
-            };
-            // The font must live as long as the process: plotters keeps a reference in its registry.
-            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-            if plotters::style::register_font(FAMILY, FontStyle::Normal, bytes).is_ok() {
-                tracing::debug!(font = %path.display(), "figures use this font");
-                return Ok(());
-            }
-        }
-        Err(PlotError::NoFont {
-            tried: candidates
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
+        let font = fonts::font().map_err(|no_font| PlotError::NoFont(no_font.clone()))?;
+        plotters::style::register_font(FAMILY, FontStyle::Normal, &font.bytes).map_err(|_| {
+            PlotError::NoFont(NoFont {
+                tried: format!("{} (not a font plotters can read)", font.path.display()),
+            })
         })
     })
     .clone()
