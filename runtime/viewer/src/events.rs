@@ -16,6 +16,15 @@ const MAX_PARTICIPANTS: usize = 1 << 20;
 /// Distinct event names at most (they are interned as `u16`).
 const MAX_NAMES: usize = u16::MAX as usize;
 
+/// Whether an `events.csv` row is the world's (a fault, join, leave, gripper or item row) rather than an event a
+/// robot's supervisors fired.
+pub fn written_by_the_world(event: &str) -> bool {
+    ["fault:", "gripper:", "item:", "join"]
+        .iter()
+        .any(|prefix| event.starts_with(prefix))
+        || event == "leave"
+}
+
 /// A fault, join or leave on the timeline.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Marker {
@@ -193,8 +202,8 @@ impl Table {
         match event {
             "fault:freeze" => participant.frozen.push(tick, true),
             "fault:thaw" | "fault:up" => participant.frozen.push(tick, false),
-            "gripper:grip" => participant.carrying.push(tick, true),
-            "gripper:release" | "gripper:lost" | "gripper:release_on_death" => {
+            "gripper:grip" | "item:picked" => participant.carrying.push(tick, true),
+            "gripper:release" | "gripper:lost" | "gripper:release_on_death" | "item:dropped" => {
                 participant.carrying.push(tick, false)
             }
             _ => {}

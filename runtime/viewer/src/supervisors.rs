@@ -57,11 +57,7 @@ impl Supervisors {
         let set = &loaded.set;
         let mut states = vec![0u16; set.supervisors.len()];
         for name in events {
-            if name.starts_with("fault:")
-                || name.starts_with("gripper:")
-                || name.starts_with("join")
-                || name == "leave"
-            {
+            if crate::events::written_by_the_world(name) {
                 continue;
             }
             let Some(&event) = loaded.ids.get(name) else {

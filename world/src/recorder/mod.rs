@@ -12,6 +12,7 @@ pub mod files;
 pub mod messages;
 pub mod scene_file;
 pub mod snapshot;
+mod snapshot_labels;
 pub mod trails;
 pub mod trajectory;
 
@@ -135,7 +136,8 @@ impl Recorder {
 
     /// Ends the world's current tick: the loop functions' output of the tick goes to its file; the physical
     /// grippers' events of the tick (`gripper:grip`, `gripper:lifted`, `gripper:lowered`, `gripper:release`,
-    /// `gripper:lost`, `gripper:release_on_death`), its trajectory rows and the events recorded since the last
+    /// `gripper:lost`, `gripper:release_on_death`) and the items picked up and put down (`item:picked`,
+    /// `item:dropped`), its trajectory rows and the events recorded since the last
     /// tick go to the writing thread; and a snapshot is drawn if this tick is scheduled.
     pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
         if let Some(output) = &mut self.loop_output {
@@ -148,7 +150,8 @@ impl Recorder {
                 GripperEvent::Lifted { robot, .. } => (robot, "gripper:lifted"),
                 GripperEvent::Lowered { robot, .. } => (robot, "gripper:lowered"),
                 GripperEvent::Released { robot, cause, .. } => (robot, cause.event_name()),
-                GripperEvent::Picked { .. } | GripperEvent::Dropped { .. } => continue,
+                GripperEvent::Picked { robot, .. } => (robot, "item:picked"),
+                GripperEvent::Dropped { robot, .. } => (robot, "item:dropped"),
             };
             self.record_fault(tick, robot.index(), name);
         }
