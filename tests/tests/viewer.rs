@@ -285,3 +285,49 @@ fn bad_run_directories_are_explained_in_the_page_and_the_terminal() {
         missing.stderr()
     );
 }
+
+/// Cells of the `pheromone.bin` frame of `tick` where any channel is above zero.
+fn marked_cells(dir: &Path, tick: u64) -> usize {
+    let scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).expect("scene.json"))
+            .expect("JSON");
+    let layout = &scene["pheromone"];
+    let number = |key: &str| layout[key].as_u64().expect("a pheromone layout number") as usize;
+    let (nx, ny, channels, every) = (
+        number("nx"),
+        number("ny"),
+        number("channels"),
+        number("every") as u64,
+    );
+    let frame = 8 + nx * ny * channels;
+    let bytes = std::fs::read(dir.join("pheromone.bin")).expect("pheromone.bin");
+    let start = (tick / every) as usize * frame;
+    let cells = &bytes[start + 8..start + frame];
+    (0..nx * ny)
+        .filter(|&c| (0..channels).any(|ch| cells[ch * nx * ny + c] > 0))
+        .count()
+}
+
+#[test]
+fn replay_draws_the_pheromone_field_recorded_for_the_shown_second() {
+    let run = tempfile::tempdir().expect("temp dir");
+    let outcome = run_to_completion(
+        "configs/pheromone_foraging/pheromone_foraging.argos",
+        run.path(),
+        &["--ticks", "400", "--robots", "20"],
+    );
+    assert!(outcome.output.status.success(), "{}", outcome.stderr());
+    let expected = marked_cells(run.path(), 380);
+    assert!(expected > 0, "the swarm laid pheromone by tick 380");
+    let page = ServedPage::start(&["view", &run.path().display().to_string(), "--port", "0"]);
+    let browser = Browser::start();
+    browser.open(&page.url);
+    browser.wait_for("viewer.ready");
+    browser.eval("(viewer.seek(395), true)");
+    // The world records the field once a second (20 ticks): tick 395 shows the field of tick 380.
+    browser.wait_for("viewer.whenPheromone(380)");
+    assert_eq!(browser.eval("viewer.pheromone().cells"), expected);
+    check_screenshot(&browser, "viewer-pheromone");
+    assert_eq!(browser.console_errors(), Vec::<String>::new());
+    assert_eq!(page.interrupt(), Some(130));
+}

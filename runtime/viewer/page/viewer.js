@@ -47,7 +47,8 @@
   const trail = { seconds: 5, frames: [], busy: false, forTick: null, forSeconds: null };
   const selection = { index: null, answer: null, busy: false, lastAt: -Infinity, timer: null, failedFor: null };
   const scrub = { timer: null, lastAt: -Infinity };
-  const waiters = { displayed: [], selected: [], liveTick: [] };
+  const waiters = { displayed: [], selected: [], liveTick: [], pheromone: [] };
+  const pheromone = { forTick: null, busy: false, tick: null, cells: 0, canvas: null };
   let shown = null;      // the displayed frame: {tick, n, f32, u8}
   let wanted = null;     // the tick the page is trying to display
   let markers = [];
@@ -189,6 +190,51 @@
     });
   }
 
+  // The pheromone field under the robots: the frame recorded last at or before the displayed tick (the world
+  // records one per simulated second), one request at a time.
+  function requestPheromone() {
+    const layout = run.scene && run.scene.pheromone;
+    if (!layout || !shown || pheromone.busy) return;
+    const tick = Math.floor(shown.tick / layout.every) * layout.every;
+    if (pheromone.forTick === tick) return;
+    pheromone.busy = true;
+    get(`/api/pheromone?tick=${tick}`, 'pheromone').then((buffer) => {
+      pheromone.busy = false;
+      pheromone.forTick = tick;
+      if (buffer && buffer.byteLength > 8) paintPheromone(layout, buffer);
+      requestDraw();
+      settle(waiters.pheromone, (w) => w.tick === pheromone.tick);
+      requestPheromone();
+    });
+  }
+
+  // Turns a frame (u64 tick, then per channel, per row from the lowest y, one byte per cell) into an image whose
+  // row 0 is the top; each cell takes the colour of its strongest channel, more opaque as it is stronger.
+  function paintPheromone({ nx, ny, channels, colours }, buffer) {
+    const cells = new Uint8Array(buffer, 8);
+    const canvas = pheromone.canvas || (pheromone.canvas = document.createElement('canvas'));
+    canvas.width = nx;
+    canvas.height = ny;
+    const painter = canvas.getContext('2d');
+    const image = painter.createImageData(nx, ny);
+    let marked = 0;
+    for (let y = 0; y < ny; y++) {
+      for (let x = 0; x < nx; x++) {
+        let strongest = 0, colour = null;
+        for (let ch = 0; ch < channels; ch++) {
+          const value = cells[(ch * ny + y) * nx + x];
+          if (value > strongest) { strongest = value; colour = colours[ch]; }
+        }
+        if (!colour) continue;
+        marked++;
+        image.data.set([...colour, Math.round(strongest * 200 / 255)], ((ny - 1 - y) * nx + x) * 4);
+      }
+    }
+    painter.putImageData(image, 0, 0);
+    pheromone.tick = Number(new DataView(buffer).getBigUint64(0, true));
+    pheromone.cells = marked;
+  }
+
   // The selected robot's panel follows the displayed tick: one request at a time, at most 5 a second, and the
   // newest wanted tick wins.
   function requestRobot() {
@@ -290,6 +336,7 @@
       el.time.textContent = (frame.tick / run.tps).toFixed(2);
       requestTrail();
       requestRobot();
+      requestPheromone();
     }
     updateRobotState();
     resolveReady();
@@ -333,6 +380,7 @@
     ctx.setTransform(view.dpr, 0, 0, view.dpr, 0, 0);
     ctx.clearRect(0, 0, view.width, view.height);
     drawArena();
+    drawPheromone();
     if (run.scene) {
       for (const target of run.scene.targets || []) drawBody(target, targetColour(target.colour));
       for (const obstacle of run.scene.obstacles || []) drawBody(obstacle, obstacle.movable ? '#8b7d70' : '#454545');
@@ -343,6 +391,15 @@
       drawRobots();
     }
     drawScaleBar();
+  }
+
+  function drawPheromone() {
+    const layout = run.scene && run.scene.pheromone;
+    if (!layout || pheromone.tick === null) return;
+    const side = layout.cell * view.scale;
+    ctx.imageSmoothingEnabled = false;
+    ctx.drawImage(pheromone.canvas, sx(layout.min[0]), sy(layout.min[1] + layout.ny * layout.cell),
+      layout.nx * side, layout.ny * side);
   }
 
   function drawArena() {
@@ -939,6 +996,8 @@
     live: () => ({
       live: Boolean(run.info && run.info.live), following: live.following, finished: live.finished, last: run.last,
     }),
+    pheromone: () => ({ tick: pheromone.tick, cells: pheromone.cells }),
+    whenPheromone: (tick) => waitFor(waiters.pheromone, { tick }, pheromone.tick === tick),
     whenLiveTick: (tick) => waitFor(waiters.liveTick, { tick },
       shown !== null && Boolean(run.info && run.info.live) && shown.tick >= tick),
   };

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use swarm_contract::run_dir::{
-    EVENTS_FILE, FLOOR_IMAGE_FILE, SCENE_FILE, SUMMARY_FILE, TRAJECTORY_FILE,
+    EVENTS_FILE, FLOOR_IMAGE_FILE, PHEROMONE_FILE, SCENE_FILE, SUMMARY_FILE, TRAJECTORY_FILE,
 };
 
 use crate::events::EventsIndex;
@@ -206,6 +206,43 @@ impl RunRecord {
             .then(|| self.dir.join(FLOOR_IMAGE_FILE))
     }
 
+    /// The pheromone field's frame (tick, then the grid; docs/viewer.md) recorded last at or before `tick`, or
+    /// `None` when the run has no field or no frame yet.
+    pub fn pheromone(&self, tick: u64) -> Result<Option<Vec<u8>>, Refusal> {
+        let Some(field) = self
+            .scene
+            .as_ref()
+            .and_then(|s| PheromoneLayout::of(&s["pheromone"]))
+        else {
+            return Ok(None);
+        };
+        let path = self.dir.join(PHEROMONE_FILE);
+        let unreadable =
+            |e: std::io::Error| Refusal::Unavailable(format!("{}: {e}", path.display()));
+        let file = match File::open(&path) {
+            Ok(file) => file,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(unreadable(e)),
+        };
+        let whole_frames = file.metadata().map_err(unreadable)?.len() / field.frame_bytes;
+        let Some(last_whole) = whole_frames.checked_sub(1) else {
+            return Ok(None);
+        };
+        let index = (tick / field.every).min(last_whole);
+        let mut frame = vec![0; field.frame_bytes as usize];
+        std::os::unix::fs::FileExt::read_exact_at(&file, &mut frame, index * field.frame_bytes)
+            .map_err(unreadable)?;
+        let recorded = u64::from_le_bytes(frame[..8].try_into().unwrap_or_default());
+        if recorded != index * field.every {
+            return Err(Refusal::Unavailable(format!(
+                "{}: frame {index} holds tick {recorded}, not {}: the file does not match scene.json",
+                path.display(),
+                index * field.every
+            )));
+        }
+        Ok(Some(frame))
+    }
+
     /// The frames of ticks `from, from + stride, ...` (at most `count`) in the layout of docs/viewer.md.
     pub fn frames(&self, from: u64, count: u64, stride: u64) -> Result<Vec<u8>, Refusal> {
         if stride == 0 || count == 0 {
@@ -289,6 +326,24 @@ impl RunRecord {
             "supervisors": supervisors,
             "problem": problem,
         }))
+    }
+}
+
+/// The pheromone file's frame size and period, as `scene.json` gives them.
+struct PheromoneLayout {
+    frame_bytes: u64,
+    every: u64,
+}
+
+impl PheromoneLayout {
+    /// The layout of a scene's `pheromone` entry; `None` for `null` or an entry without sane numbers.
+    fn of(entry: &Value) -> Option<Self> {
+        let number = |key: &str| entry[key].as_u64().filter(|&n| (1..=1 << 16).contains(&n));
+        let cells = number("nx")? * number("ny")? * number("channels")?;
+        Some(Self {
+            frame_bytes: 8 + cells,
+            every: number("every")?,
+        })
     }
 }
 

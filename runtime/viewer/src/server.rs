@@ -57,6 +57,7 @@ pub fn routes(shared: Shared) -> Router {
         .route("/api/run", get(run))
         .route("/api/floor.png", get(floor))
         .route("/api/frames", get(frames))
+        .route("/api/pheromone", get(pheromone))
         .route("/api/timeline", get(timeline))
         .route("/api/robot/{index}", get(robot))
         .route("/api/live", get(live))
@@ -122,6 +123,22 @@ fn one() -> u64 {
 async fn frames(State(shared): State<Shared>, Query(query): Query<FramesQuery>) -> Response {
     match shared.fresh().frames(query.from, query.count, query.stride) {
         Ok(body) => ([(header::CONTENT_TYPE, "application/octet-stream")], body).into_response(),
+        Err(refusal) => refused(refusal),
+    }
+}
+
+/// `/api/pheromone` parameters.
+#[derive(Deserialize)]
+struct PheromoneQuery {
+    tick: u64,
+}
+
+async fn pheromone(State(shared): State<Shared>, Query(query): Query<PheromoneQuery>) -> Response {
+    match shared.fresh().pheromone(query.tick) {
+        Ok(Some(frame)) => {
+            ([(header::CONTENT_TYPE, "application/octet-stream")], frame).into_response()
+        }
+        Ok(None) => StatusCode::NO_CONTENT.into_response(),
         Err(refusal) => refused(refusal),
     }
 }

@@ -73,6 +73,16 @@ impl PheromoneField {
         }
     }
 
+    /// Whether the run has a pheromone medium (the field of a run without one is never deposited into).
+    pub fn is_active(&self) -> bool {
+        self.active
+    }
+
+    /// The corner of cell (0, 0), at the arena's minimum.
+    pub fn origin(&self) -> Vec2 {
+        self.origin
+    }
+
     /// Grid size (columns, rows) and cell side in metres.
     pub fn dimensions(&self) -> (usize, usize, f32) {
         (self.nx, self.ny, self.cell)

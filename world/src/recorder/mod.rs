@@ -10,6 +10,7 @@ mod csv_line;
 pub mod events;
 pub mod files;
 pub mod messages;
+pub mod pheromone_file;
 pub mod scene_file;
 pub mod snapshot;
 mod snapshot_labels;
@@ -39,6 +40,7 @@ pub struct Recorder {
     files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
     loop_output: Option<LoopOutput>,
+    pheromone: Option<pheromone_file::PheromoneFile>,
     trails: trails::Trails,
 }
 
@@ -82,7 +84,11 @@ impl Recorder {
                 .then(|| messages::MessagesWriter::create(dir))
                 .transpose()?,
         };
-        scene_file::write(dir, world)?;
+        let pheromone = pheromone_file::PheromoneFile::create(dir, &world.arena)?;
+        let pheromone_entry = pheromone
+            .as_ref()
+            .map_or(serde_json::Value::Null, |p| p.describe(&world.arena));
+        scene_file::write(dir, world, pheromone_entry)?;
         let loop_output = match world.loop_output_name() {
             None => None,
             Some(name) => {
@@ -103,6 +109,7 @@ impl Recorder {
             files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
             loop_output,
+            pheromone,
             trails: trails::Trails::default(),
         })
     }
@@ -142,6 +149,9 @@ impl Recorder {
     pub fn record(&mut self, world: &mut World) -> Result<(), WorldError> {
         if let Some(output) = &mut self.loop_output {
             output.write(world)?;
+        }
+        if let Some(pheromone) = &mut self.pheromone {
+            pheromone.record(&world.arena)?;
         }
         let tick = world.tick();
         for event in &world.arena.gripper_events {

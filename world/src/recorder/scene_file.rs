@@ -26,8 +26,9 @@ const FLOOR_CELL: f32 = 0.02;
 /// Largest floor image side in cells.
 const MAX_FLOOR_SIDE: f32 = 1024.0;
 
-/// Writes `scene.json` (and `floor.png` when some of the floor is not white) into `dir`.
-pub fn write(dir: &Path, world: &World) -> Result<(), WorldError> {
+/// Writes `scene.json` (and `floor.png` when some of the floor is not white) into `dir`; `pheromone` is the
+/// pheromone file's entry (`null` without one).
+pub fn write(dir: &Path, world: &World, pheromone: Value) -> Result<(), WorldError> {
     let floor = write_floor(dir, world)?;
     let arena = &world.arena;
     let robots: Vec<Value> = arena
@@ -83,6 +84,7 @@ pub fn write(dir: &Path, world: &World) -> Result<(), WorldError> {
         "targets": targets,
         "lights": lights,
         "floor": floor,
+        "pheromone": pheromone,
     });
     let path = dir.join(SCENE_FILE);
     let text = serde_json::to_string(&scene).unwrap_or_default();
@@ -94,7 +96,7 @@ fn point(p: Vec2) -> Value {
 }
 
 /// `value` as the shortest decimal that reads back as the same `f32` (1.6, not 1.600000023841858).
-fn short(value: f32) -> f64 {
+pub(super) fn short(value: f32) -> f64 {
     value.to_string().parse().unwrap_or(f64::NAN)
 }
 

@@ -44,7 +44,7 @@ const LIGHT: Rgba = [255, 200, 0, 255];
 /// Radius of a light's dot in metres.
 const LIGHT_RADIUS: f32 = 0.05;
 /// Colours of the pheromone channels in the heat map.
-const PHEROMONE_COLOURS: [(u8, u8, u8); PHEROMONE_CHANNELS] = [(220, 60, 20), (30, 90, 220)];
+pub const PHEROMONE_COLOURS: [(u8, u8, u8); PHEROMONE_CHANNELS] = [(220, 60, 20), (30, 90, 220)];
 
 /// An anti-aliased paint of `colour`.
 pub(super) fn paint([r, g, b, a]: Rgba) -> Paint<'static> {
