@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 
 /// Bytes read per call at most, so that indexing a huge file never holds more than this in memory at once.
 const MAX_READ: usize = 8 << 20;
+/// Longest line accepted: a record row is a few dozen bytes, so a longer one means the file is not a record.
+pub const MAX_LINE: usize = 1 << 20;
 
 /// Where reading of one file stands.
 pub struct GrowingLines {
@@ -95,6 +97,15 @@ impl GrowingLines {
                 self.pending.clear();
                 return Ok(true);
             }
+            if self.pending.len() > MAX_LINE {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!(
+                        "line {} is longer than {MAX_LINE} bytes: not a record file",
+                        self.next_line
+                    ),
+                ));
+            }
             if read < MAX_READ {
                 return Ok(true);
             }
@@ -138,6 +149,19 @@ mod tests {
             vec![(2, 4, "b,2".to_owned()), (3, 8, "c,3".to_owned())]
         );
         assert_eq!(lines.unfinished_bytes(), 0);
+    }
+
+    #[test]
+    fn an_endless_line_is_refused_without_holding_the_file() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("f.csv");
+        std::fs::write(&path, vec![b'x'; super::MAX_LINE + 10]).expect("written");
+        let mut lines = GrowingLines::new(&path);
+        let error = lines.read_new(|_| true).expect_err("refused");
+        assert!(
+            error.to_string().contains("line 1 is longer than"),
+            "{error}"
+        );
     }
 
     #[test]

@@ -19,6 +19,8 @@ use crate::trajectory::TrajectoryIndex;
 pub const SCENE_FORMAT: u64 = 1;
 /// Frames served by one request at most.
 pub const MAX_FRAMES: u64 = 1024;
+/// Bytes of frames served by one request at most (fewer frames for very large swarms).
+pub const MAX_FRAME_BYTES: u64 = 32 << 20;
 /// Events of a robot shown at most.
 pub const RECENT_EVENTS: usize = 50;
 /// Largest `scene.json` read, in bytes (a scene lists every robot and obstacle once).
@@ -250,7 +252,10 @@ impl RunRecord {
                 "count and stride must be at least 1".to_owned(),
             ));
         }
-        let count = count.min(MAX_FRAMES);
+        let frame_bytes = 4 + 16 * self.robot_count() as u64;
+        let count = count
+            .min(MAX_FRAMES)
+            .min((MAX_FRAME_BYTES / frame_bytes).max(1));
         let (Some((first, last)), Some(file)) = (
             self.trajectory.complete_ticks(),
             self.trajectory_file.as_ref(),
