@@ -106,25 +106,9 @@ impl EventsIndex {
 
     /// Reads the rows written since the last call. Returns whether the file exists.
     pub fn update(&mut self) -> bool {
-        if self.problem.is_some() {
-            return true;
-        }
-        let path = self.lines.path().display().to_string();
-        let (table, problem) = (&mut self.table, &mut self.problem);
-        let read = self.lines.read_new(|line| match table.add(line.text) {
-            Ok(()) => true,
-            Err(what) => {
-                *problem = Some(format!("{path}:{}: {what}", line.number));
-                false
-            }
-        });
-        match read {
-            Ok(exists) => exists,
-            Err(e) => {
-                self.problem = Some(format!("{path}: {e}"));
-                true
-            }
-        }
+        let table = &mut self.table;
+        self.lines
+            .read_until_problem(&mut self.problem, |line| table.add(line.text))
     }
 
     /// The faults, joins and leaves, and whether more were left out.

@@ -111,6 +111,29 @@ impl GrowingLines {
             }
         }
     }
+
+    /// Hands the new lines to `each` until it refuses one: the first refusal (or read error) becomes `problem`
+    /// (`file:line: what`) and ends reading for good. Returns whether the file exists.
+    pub fn read_until_problem(
+        &mut self,
+        problem: &mut Option<String>,
+        mut each: impl FnMut(Line<'_>) -> Result<(), String>,
+    ) -> bool {
+        if problem.is_some() {
+            return true;
+        }
+        let path = self.path.display().to_string();
+        let read = self.read_new(|line| {
+            let number = line.number;
+            each(line)
+                .map_err(|what| *problem = Some(format!("{path}:{number}: {what}")))
+                .is_ok()
+        });
+        read.unwrap_or_else(|e| {
+            *problem = Some(format!("{path}: {e}"));
+            true
+        })
+    }
 }
 
 #[cfg(test)]

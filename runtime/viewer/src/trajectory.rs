@@ -98,30 +98,12 @@ impl TrajectoryIndex {
 
     /// Indexes the lines written since the last call. Returns whether the file exists.
     pub fn update(&mut self) -> bool {
-        if self.problem.is_some() {
-            return true;
-        }
-        let path = self.lines.path().display().to_string();
-        let (ticks, end, problem) = (&mut self.ticks, &mut self.end, &mut self.problem);
-        let read = self.lines.read_new(|line| {
-            match ticks.index_line(line.number, line.offset, line.text) {
-                Ok(()) => {
-                    *end = line.offset + line.text.len() as u64 + 1;
-                    true
-                }
-                Err(what) => {
-                    *problem = Some(format!("{path}:{}: {what}", line.number));
-                    false
-                }
-            }
-        });
-        match read {
-            Ok(exists) => exists,
-            Err(e) => {
-                self.problem = Some(format!("{path}: {e}"));
-                true
-            }
-        }
+        let (ticks, end) = (&mut self.ticks, &mut self.end);
+        self.lines.read_until_problem(&mut self.problem, |line| {
+            ticks.index_line(line.number, line.offset, line.text)?;
+            *end = line.offset + line.text.len() as u64 + 1;
+            Ok(())
+        })
     }
 
     /// The first and last ticks whose every row is in the file.
