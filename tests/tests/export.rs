@@ -68,3 +68,42 @@ fn a_run_exported_to_parquet_and_back_gives_the_worlds_csv_byte_for_byte() {
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
+
+#[test]
+fn a_run_drawn_as_an_animated_gif() {
+    let run = tempfile::tempdir().expect("temp dir");
+    let outcome = run_to_completion(
+        "configs/foraging/quick.argos",
+        run.path(),
+        &["--ticks", "40"],
+    );
+    assert!(outcome.output.status.success(), "{}", outcome.stderr());
+    let gif = run.path().join("run.gif");
+    let (dir, path) = (run.path().display().to_string(), gif.display().to_string());
+    let drawn = swarm(&[
+        "view",
+        &dir,
+        "--gif",
+        &path,
+        "--gif-frames",
+        "20",
+        "--gif-width",
+        "200",
+    ]);
+    assert!(drawn.output.status.success(), "{}", drawn.stderr());
+    assert!(
+        drawn.stdout().contains("20 frames, 200 x 200"),
+        "{}",
+        drawn.stdout()
+    );
+    assert_eq!(&std::fs::read(&gif).expect("the GIF")[..6], b"GIF89a");
+
+    std::fs::remove_file(run.path().join("scene.json")).expect("scene removed");
+    let refused = swarm(&["view", &dir, "--gif", &path]);
+    assert_eq!(refused.output.status.code(), Some(1));
+    assert!(
+        refused.stderr().contains("scene.json is missing"),
+        "{}",
+        refused.stderr()
+    );
+}

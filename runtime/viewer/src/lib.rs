@@ -5,6 +5,7 @@
 //! demand (the trajectory is indexed by tick, never loaded whole), so the viewer works for runs of any length,
 //! and a live run never waits for it.
 
+pub mod animation;
 pub mod events;
 pub mod frames;
 pub mod lines;

@@ -256,17 +256,7 @@ impl RunRecord {
         let count = count
             .min(MAX_FRAMES)
             .min((MAX_FRAME_BYTES / frame_bytes).max(1));
-        let (Some((first, last)), Some(file)) = (
-            self.trajectory.complete_ticks(),
-            self.trajectory_file.as_ref(),
-        ) else {
-            return Err(Refusal::Unavailable(
-                self.problems()
-                    .into_iter()
-                    .next()
-                    .unwrap_or_else(|| "no complete tick has been recorded yet".to_owned()),
-            ));
-        };
+        let (first, last, _) = self.readable_trajectory()?;
         let ticks: Vec<u64> = (0..count)
             .map_while(|i| {
                 i.checked_mul(stride)
@@ -277,24 +267,47 @@ impl RunRecord {
         let robots = self.robot_count();
         let mut body = frames::header(robots, ticks.len());
         for tick in ticks {
-            let poses = self
-                .trajectory
-                .read_tick(file, tick)
-                .map_err(Refusal::Unavailable)?;
-            frames::push_frame(
-                &mut body,
-                tick,
-                poses.iter().enumerate().map(|(robot, pose)| {
-                    let (frozen, carrying) = self.events.flags_at(robot, tick);
-                    FrameRobot {
-                        pose: *pose,
-                        frozen,
-                        carrying,
-                    }
-                }),
-            );
+            frames::push_frame(&mut body, tick, self.poses(tick)?.into_iter());
         }
         Ok(body)
+    }
+
+    /// Every robot of the complete tick `tick`, by robot index: its trajectory row with the frozen and carrying
+    /// flags of the events up to it.
+    pub fn poses(&self, tick: u64) -> Result<Vec<FrameRobot>, Refusal> {
+        let (_, _, file) = self.readable_trajectory()?;
+        let poses = self
+            .trajectory
+            .read_tick(file, tick)
+            .map_err(Refusal::Unavailable)?;
+        Ok(poses
+            .into_iter()
+            .enumerate()
+            .map(|(robot, pose)| {
+                let (frozen, carrying) = self.events.flags_at(robot, tick);
+                FrameRobot {
+                    pose,
+                    frozen,
+                    carrying,
+                }
+            })
+            .collect())
+    }
+
+    /// The first and last complete ticks and the open trajectory, or why there is none.
+    fn readable_trajectory(&self) -> Result<(u64, u64, &File), Refusal> {
+        match (
+            self.trajectory.complete_ticks(),
+            self.trajectory_file.as_ref(),
+        ) {
+            (Some((first, last)), Some(file)) => Ok((first, last, file)),
+            _ => Err(Refusal::Unavailable(
+                self.problems()
+                    .into_iter()
+                    .next()
+                    .unwrap_or_else(|| "no complete tick has been recorded yet".to_owned()),
+            )),
+        }
     }
 
     /// The answer of `/api/timeline`.

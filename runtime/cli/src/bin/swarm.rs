@@ -128,7 +128,7 @@ enum Commands {
         format: swarm_cli::export::Format,
     },
     /// Replay a run in the browser: serves a local web page of the run directory and prints its URL; Ctrl-C
-    /// stops it (docs/viewer.md).
+    /// stops it (docs/viewer.md). With --gif, writes an animated GIF of the run instead.
     View {
         /// The run directory (a `swarm run --out`, or a run of an experiment batch).
         run: PathBuf,
@@ -138,6 +138,15 @@ enum Commands {
         /// Address to listen on (default 127.0.0.1: this machine only).
         #[arg(long, default_value = "127.0.0.1")]
         bind: IpAddr,
+        /// Serve nothing: write an animated GIF of the run to this file and exit.
+        #[arg(long, value_name = "FILE")]
+        gif: Option<PathBuf>,
+        /// Frames of the GIF, spread evenly over the run.
+        #[arg(long, value_name = "N", requires = "gif", default_value_t = swarm_viewer::animation::DEFAULT_FRAMES)]
+        gif_frames: u32,
+        /// Width of the GIF in pixels (its height follows the arena).
+        #[arg(long, value_name = "PX", requires = "gif", default_value_t = swarm_viewer::animation::DEFAULT_WIDTH_PX)]
+        gif_width: u32,
     },
     /// Drive a live run from another terminal: list its robots, kill, freeze or thaw one.
     Ctl {
@@ -470,7 +479,26 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Commands::View { run, port, bind } => {
+        Commands::View {
+            gif: Some(gif),
+            run,
+            gif_frames,
+            gif_width,
+            ..
+        } => {
+            let options = swarm_viewer::animation::GifOptions {
+                frames: gif_frames,
+                width_px: gif_width,
+                ..Default::default()
+            };
+            let report = swarm_viewer::animation::write_gif(&run, &gif, &options)
+                .with_context(|| format!("drawing {} as a GIF", run.display()))?;
+            println!("{report}");
+            Ok(ExitCode::SUCCESS)
+        }
+        Commands::View {
+            run, port, bind, ..
+        } => {
             let stop = Arc::new(AtomicBool::new(false));
             let interrupts = interrupt_channel(&stop)?;
             let viewer = swarm_viewer::Viewer::start(&run, false, bind, port)
