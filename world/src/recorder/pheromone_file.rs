@@ -69,7 +69,7 @@ impl PheromoneFile {
 
     /// Writes the field if the arena's tick is a multiple of the period.
     pub fn record(&mut self, arena: &Arena) -> Result<(), WorldError> {
-        if arena.tick % self.every != 0 {
+        if !arena.tick.is_multiple_of(self.every) {
             return Ok(());
         }
         let (nx, ny, _) = arena.pheromone.dimensions();
