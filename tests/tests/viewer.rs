@@ -331,3 +331,35 @@ fn replay_draws_the_pheromone_field_recorded_for_the_shown_second() {
     assert_eq!(browser.console_errors(), Vec::<String>::new());
     assert_eq!(page.interrupt(), Some(130));
 }
+
+/// A benchmark, not a check: plays the run in `SWARM_VIEWER_BENCH_RUN` (e.g. 1,000 robots x 10,000 ticks) at 16x
+/// in headless Chromium for 10 s and prints how many frames the page drew and how many distinct ticks it showed.
+/// `SWARM_VIEWER_BENCH_RUN=/tmp/long cargo test --release -p swarm-system-tests --test viewer -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn playing_a_long_run() {
+    let dir = std::env::var("SWARM_VIEWER_BENCH_RUN")
+        .expect("SWARM_VIEWER_BENCH_RUN names a run directory");
+    swarm_system_tests::bin_dir();
+    let started = std::time::Instant::now();
+    let page = ServedPage::start(&["view", &dir, "--port", "0"]);
+    let serving = started.elapsed();
+    let browser = Browser::start();
+    browser.open(&page.url);
+    browser.wait_for("viewer.ready");
+    let ready = started.elapsed();
+    let played = browser.wait_for(
+        "(() => { const s = document.querySelector('#speed'); s.value = '16'; \
+         s.dispatchEvent(new Event('change', {bubbles: true})); \
+         const before = viewer.counts(), tick = viewer.tick(), t0 = performance.now(); \
+         document.querySelector('#play').click(); \
+         return new Promise(done => setTimeout(() => { const after = viewer.counts(); \
+           done({seconds: (performance.now() - t0) / 1000, draws: after.draws - before.draws, \
+                 ticks: after.ticksShown - before.ticksShown, advanced: viewer.tick() - tick}); }, 10000)); })()",
+    );
+    println!(
+        "{dir}: URL after {serving:.2?}, first frame drawn after {ready:.2?}; playing at 16x: {played}; console errors: {:?}",
+        browser.console_errors()
+    );
+    assert_eq!(page.interrupt(), Some(130));
+}

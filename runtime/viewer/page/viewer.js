@@ -44,6 +44,7 @@
   const play = { playing: false, speed: 1, stride: 1, playhead: 0, lastTime: 0 };
   const live = { source: null, following: false, finished: false, newest: null };
   const view = { scale: 1, ox: 0, oy: 0, width: 0, height: 0, dpr: 1, userMoved: false, drawQueued: false };
+  const counts = { draws: 0, ticksShown: 0 };   // for the benchmark that plays a long run
   const trail = { seconds: 5, frames: [], busy: false, forTick: null, forSeconds: null };
   const selection = { index: null, answer: null, busy: false, lastAt: -Infinity, timer: null, failedFor: null };
   const scrub = { timer: null, lastAt: -Infinity };
@@ -332,6 +333,7 @@
     if (first && !run.scene) fitView();
     render();
     if (changed) {
+      counts.ticksShown++;
       el.tick.textContent = String(frame.tick);
       el.time.textContent = (frame.tick / run.tps).toFixed(2);
       requestTrail();
@@ -377,6 +379,7 @@
 
   function render() {
     if (view.width === 0 || view.height === 0) return;
+    counts.draws++;
     ctx.setTransform(view.dpr, 0, 0, view.dpr, 0, 0);
     ctx.clearRect(0, 0, view.width, view.height);
     drawArena();
@@ -997,6 +1000,7 @@
       live: Boolean(run.info && run.info.live), following: live.following, finished: live.finished, last: run.last,
     }),
     pheromone: () => ({ tick: pheromone.tick, cells: pheromone.cells }),
+    counts: () => ({ ...counts }),
     whenPheromone: (tick) => waitFor(waiters.pheromone, { tick }, pheromone.tick === tick),
     whenLiveTick: (tick) => waitFor(waiters.liveTick, { tick },
       shown !== null && Boolean(run.info && run.info.live) && shown.tick >= tick),
