@@ -28,7 +28,7 @@ pub enum ViewerError {
     NotARun(String),
     /// The port is taken.
     #[error(
-        "{address} is in use by another program: choose another --port, or --port 0 for any free one"
+        "{address} is in use by another program: choose another port, or port 0 for any free one"
     )]
     PortInUse {
         /// The address asked for.
