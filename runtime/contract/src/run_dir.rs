@@ -25,6 +25,8 @@ pub const MESSAGES_FILE: &str = "messages.csv";
 pub const SCENE_FILE: &str = "scene.json";
 /// The floor's grey levels as an image over the arena (runs whose floor is not all white).
 pub const FLOOR_IMAGE_FILE: &str = "floor.png";
+/// Where the targets and movable obstacles are, a row whenever one moved (runs with any): for replays.
+pub const OBJECTS_FILE: &str = "objects.csv";
 /// The pheromone field once a second (runs with a pheromone medium): for replays.
 pub const PHEROMONE_FILE: &str = "pheromone.bin";
 /// Each controller's event names by id, for the world's `events.csv`.

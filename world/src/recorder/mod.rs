@@ -10,6 +10,7 @@ mod csv_line;
 pub mod events;
 pub mod files;
 pub mod messages;
+pub mod objects_file;
 pub mod pheromone_file;
 pub mod scene_file;
 pub mod snapshot;
@@ -40,6 +41,7 @@ pub struct Recorder {
     files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
     loop_output: Option<LoopOutput>,
+    objects: Option<objects_file::ObjectsFile>,
     pheromone: Option<pheromone_file::PheromoneFile>,
     trails: trails::Trails,
 }
@@ -84,6 +86,7 @@ impl Recorder {
                 .then(|| messages::MessagesWriter::create(dir))
                 .transpose()?,
         };
+        let objects = objects_file::ObjectsFile::create(dir, &world.arena)?;
         let pheromone = pheromone_file::PheromoneFile::create(dir, &world.arena)?;
         let pheromone_entry = pheromone
             .as_ref()
@@ -109,6 +112,7 @@ impl Recorder {
             files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
             loop_output,
+            objects,
             pheromone,
             trails: trails::Trails::default(),
         })
@@ -152,6 +156,9 @@ impl Recorder {
         }
         if let Some(pheromone) = &mut self.pheromone {
             pheromone.record(&world.arena)?;
+        }
+        if let Some(objects) = &mut self.objects {
+            objects.record(&world.arena)?;
         }
         let tick = world.tick();
         for event in &world.arena.gripper_events {

@@ -1,7 +1,7 @@
 //! `scene.json` and `floor.png`: what a viewer needs besides the per-tick records to draw a run. Written once,
 //! when recording starts (tick 0): the arena rectangle, every obstacle, target and light as placed, and each
-//! participant's id, controller and body. Movable objects are drawn where they start; their final poses are in
-//! `summary.json`.
+//! participant's id, controller and body. Where targets and movable obstacles go later is in `objects.csv`
+//! ([`super::objects_file`]).
 //!
 //! The layout is described in docs/records.md; `format` grows when a field changes meaning.
 
