@@ -363,3 +363,41 @@ fn playing_a_long_run() {
     );
     assert_eq!(page.interrupt(), Some(130));
 }
+
+#[test]
+fn replay_draws_a_pushed_box_where_objects_csv_puts_it() {
+    let run = tempfile::tempdir().expect("temp dir");
+    let outcome = run_to_completion("configs/transport/sample2.argos", run.path(), &[]);
+    assert!(outcome.output.status.success(), "{}", outcome.stderr());
+    let objects = std::fs::read_to_string(run.path().join("objects.csv")).expect("objects.csv");
+    let rows: Vec<Vec<&str>> = objects
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let middle = &rows[rows.len() / 2];
+    assert_eq!(middle[1], "obstacle", "the pushed box moves: {middle:?}");
+    let tick: u64 = middle[0].parse().expect("a tick");
+    let page = ServedPage::start(&["view", &run.path().display().to_string(), "--port", "0"]);
+    let browser = Browser::start();
+    browser.open(&page.url);
+    browser.wait_for("viewer.ready");
+    browser.eval(&format!("(viewer.seek({tick}), true)"));
+    browser.wait_for(&format!("viewer.whenObjects({tick})"));
+    let shown = browser.eval("viewer.objects().obstacles");
+    let index: u64 = middle[2].parse().expect("an index");
+    let entry = shown
+        .as_array()
+        .and_then(|all| all.iter().find(|e| e[0] == index))
+        .unwrap_or_else(|| panic!("obstacle {index} in {shown}"));
+    let pose: Vec<f32> = (0..3)
+        .map(|i| entry[1][i].as_f64().unwrap_or(f64::NAN) as f32)
+        .collect();
+    let recorded: Vec<f32> = middle[4..7]
+        .iter()
+        .map(|v| v.parse().expect("a number"))
+        .collect();
+    assert_eq!(pose, recorded, "the box at tick {tick}");
+    assert_eq!(browser.console_errors(), Vec::<String>::new());
+    assert_eq!(page.interrupt(), Some(130));
+}

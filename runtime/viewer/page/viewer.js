@@ -48,8 +48,10 @@
   const trail = { seconds: 5, frames: [], busy: false, forTick: null, forSeconds: null };
   const selection = { index: null, answer: null, busy: false, lastAt: -Infinity, timer: null, failedFor: null };
   const scrub = { timer: null, lastAt: -Infinity };
-  const waiters = { displayed: [], selected: [], liveTick: [], pheromone: [] };
+  const waiters = { displayed: [], selected: [], liveTick: [], pheromone: [], objects: [] };
   const pheromone = { forTick: null, busy: false, tick: null, cells: 0, canvas: null };
+  // Where targets and movable obstacles are at the shown tick (/api/objects), by index: [x, y, angle, in_arena].
+  const objects = { forTick: null, busy: false, tick: null, targets: new Map(), obstacles: new Map() };
   let shown = null;      // the displayed frame: {tick, n, f32, u8}
   let wanted = null;     // the tick the page is trying to display
   let markers = [];
@@ -209,6 +211,31 @@
     });
   }
 
+  // Targets and movable obstacles at the displayed tick, one request at a time; scene poses until it answers.
+  function requestObjects() {
+    if (!run.scene || !shown || objects.busy || objects.forTick === shown.tick) return;
+    const tick = shown.tick;
+    objects.busy = true;
+    get(`/api/objects?tick=${tick}`, 'objects', 'json').then((reply) => {
+      objects.busy = false;
+      objects.forTick = tick;
+      if (reply) {
+        const byIndex = (rows) => new Map(rows.map(([index, ...pose]) => [index, pose]));
+        Object.assign(objects, { tick, targets: byIndex(reply.targets), obstacles: byIndex(reply.obstacles) });
+        requestDraw();
+        settle(waiters.objects, (w) => w.tick === tick);
+      }
+      requestObjects();
+    });
+  }
+
+  // `body` of the scene where /api/objects last put it, or null when it is out of the arena.
+  function placed(body, pose) {
+    if (!pose) return body;
+    const [x, y, angle, inArena] = pose;
+    return inArena ? { ...body, x, y, angle } : null;
+  }
+
   // Turns a frame (u64 tick, then per channel, per row from the lowest y, one byte per cell) into an image whose
   // row 0 is the top; each cell takes the colour of its strongest channel, more opaque as it is stronger.
   function paintPheromone({ nx, ny, channels, colours }, buffer) {
@@ -339,6 +366,7 @@
       requestTrail();
       requestRobot();
       requestPheromone();
+      requestObjects();
     }
     updateRobotState();
     resolveReady();
@@ -385,8 +413,14 @@
     drawArena();
     drawPheromone();
     if (run.scene) {
-      for (const target of run.scene.targets || []) drawBody(target, targetColour(target.colour));
-      for (const obstacle of run.scene.obstacles || []) drawBody(obstacle, obstacle.movable ? '#8b7d70' : '#454545');
+      (run.scene.targets || []).forEach((target, i) => {
+        const body = placed(target, objects.targets.get(i));
+        if (body) drawBody(body, targetColour(target.colour));
+      });
+      (run.scene.obstacles || []).forEach((obstacle, i) => {
+        const body = placed(obstacle, objects.obstacles.get(i));
+        if (body) drawBody(body, obstacle.movable ? '#8b7d70' : '#454545');
+      });
       drawLights();
     }
     if (shown) {
@@ -1001,6 +1035,8 @@
     }),
     pheromone: () => ({ tick: pheromone.tick, cells: pheromone.cells }),
     counts: () => ({ ...counts }),
+    objects: () => ({ tick: objects.tick, targets: [...objects.targets], obstacles: [...objects.obstacles] }),
+    whenObjects: (tick) => waitFor(waiters.objects, { tick }, objects.tick === tick),
     whenPheromone: (tick) => waitFor(waiters.pheromone, { tick }, pheromone.tick === tick),
     whenLiveTick: (tick) => waitFor(waiters.liveTick, { tick },
       shown !== null && Boolean(run.info && run.info.live) && shown.tick >= tick),

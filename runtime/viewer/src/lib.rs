@@ -9,6 +9,7 @@ pub mod animation;
 pub mod events;
 pub mod frames;
 pub mod lines;
+pub mod objects;
 pub mod page;
 pub mod run;
 pub mod server;

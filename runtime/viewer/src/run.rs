@@ -7,11 +7,13 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use swarm_contract::run_dir::{
-    EVENTS_FILE, FLOOR_IMAGE_FILE, PHEROMONE_FILE, SCENE_FILE, SUMMARY_FILE, TRAJECTORY_FILE,
+    EVENTS_FILE, FLOOR_IMAGE_FILE, OBJECTS_FILE, PHEROMONE_FILE, SCENE_FILE, SUMMARY_FILE,
+    TRAJECTORY_FILE,
 };
 
 use crate::events::EventsIndex;
 use crate::frames::{self, FrameRobot};
+use crate::objects::{ObjectPlaces, ObjectsIndex};
 use crate::supervisors::Supervisors;
 use crate::trajectory::TrajectoryIndex;
 
@@ -47,6 +49,7 @@ pub struct RunRecord {
     trajectory: TrajectoryIndex,
     trajectory_file: Option<File>,
     events: EventsIndex,
+    objects: ObjectsIndex,
     supervisors: Supervisors,
 }
 
@@ -76,6 +79,7 @@ impl RunRecord {
             trajectory: TrajectoryIndex::new(&dir.join(TRAJECTORY_FILE), None),
             trajectory_file: None,
             events: EventsIndex::new(&dir.join(EVENTS_FILE), None),
+            objects: ObjectsIndex::new(&dir.join(OBJECTS_FILE), 0, 0),
             supervisors: Supervisors::new(dir),
         };
         record.refresh();
@@ -101,6 +105,7 @@ impl RunRecord {
             self.trajectory_file = File::open(self.dir.join(TRAJECTORY_FILE)).ok();
         }
         self.events.update();
+        self.objects.update();
     }
 
     fn load_scene(&mut self) {
@@ -137,6 +142,12 @@ impl RunRecord {
         let participants = robots.len() + scene["coordinators"].as_array().map_or(0, Vec::len);
         self.trajectory = TrajectoryIndex::new(&self.dir.join(TRAJECTORY_FILE), Some(robots.len()));
         self.events = EventsIndex::new(&self.dir.join(EVENTS_FILE), Some(participants));
+        let count = |key: &str| scene[key].as_array().map_or(0, Vec::len);
+        self.objects = ObjectsIndex::new(
+            &self.dir.join(OBJECTS_FILE),
+            count("targets"),
+            count("obstacles"),
+        );
         self.trajectory_file = None;
         self.robots = robots;
         self.scene_problem = None;
@@ -148,6 +159,7 @@ impl RunRecord {
         let mut problems: Vec<String> = self.scene_problem.iter().cloned().collect();
         problems.extend(self.trajectory.problem().map(str::to_owned));
         problems.extend(self.events.problem().map(str::to_owned));
+        problems.extend(self.objects.problem().map(str::to_owned));
         let finished = self.finished();
         if !self.dir.join(TRAJECTORY_FILE).exists() && (finished || !self.live) {
             problems.push(format!(
@@ -308,6 +320,16 @@ impl RunRecord {
                     .unwrap_or_else(|| "no complete tick has been recorded yet".to_owned()),
             )),
         }
+    }
+
+    /// The answer of `/api/objects?tick=T`: where each target and movable obstacle is at `tick`.
+    pub fn objects(&self, tick: u64) -> Value {
+        self.objects.at(tick)
+    }
+
+    /// Where each target and movable obstacle is at `tick`, by scene index.
+    pub fn object_places(&self, tick: u64) -> ObjectPlaces {
+        self.objects.places_at(tick)
     }
 
     /// The answer of `/api/timeline`.

@@ -57,6 +57,7 @@ pub fn routes(shared: Shared) -> Router {
         .route("/api/run", get(run))
         .route("/api/floor.png", get(floor))
         .route("/api/frames", get(frames))
+        .route("/api/objects", get(objects))
         .route("/api/pheromone", get(pheromone))
         .route("/api/timeline", get(timeline))
         .route("/api/robot/{index}", get(robot))
@@ -127,13 +128,17 @@ async fn frames(State(shared): State<Shared>, Query(query): Query<FramesQuery>) 
     }
 }
 
-/// `/api/pheromone` parameters.
+/// `/api/pheromone` and `/api/objects` parameters.
 #[derive(Deserialize)]
-struct PheromoneQuery {
+struct TickQuery {
     tick: u64,
 }
 
-async fn pheromone(State(shared): State<Shared>, Query(query): Query<PheromoneQuery>) -> Response {
+async fn objects(State(shared): State<Shared>, Query(query): Query<TickQuery>) -> Response {
+    axum::Json(shared.fresh().objects(query.tick)).into_response()
+}
+
+async fn pheromone(State(shared): State<Shared>, Query(query): Query<TickQuery>) -> Response {
     match shared.fresh().pheromone(query.tick) {
         Ok(Some(frame)) => {
             ([(header::CONTENT_TYPE, "application/octet-stream")], frame).into_response()

@@ -334,7 +334,7 @@ fn draw<'p>(
     if let Some(field) = record.pheromone(tick)? {
         painter.show_field(&field);
     }
-    Ok(painter.draw(&record.poses(tick)?, progress))
+    Ok(painter.draw(&record.poses(tick)?, &record.object_places(tick), progress))
 }
 
 fn write_failed(out: &Path) -> impl Fn(io::Error) -> AnimationError + '_ {

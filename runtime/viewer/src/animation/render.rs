@@ -12,6 +12,7 @@ use tiny_skia::{
 use super::AnimationError;
 use super::scene::{Body, Bounds, FieldLayout, Scene, Shape};
 use crate::frames::FrameRobot;
+use crate::objects::{ObjectPlace, ObjectPlaces};
 
 /// Largest side of an animation in pixels.
 pub const MAX_SIDE_PX: u32 = 4096;
@@ -152,16 +153,8 @@ impl Painter {
             };
             draw_image(pixmap, image, &bounds, view);
         }
-        for target in &scene.targets {
-            let colour = target
-                .colour
-                .filter(|&c| c != [0; 3])
-                .map_or(TARGET, |[r, g, b]| [r, g, b, 255]);
-            fill_body(pixmap, target, colour, view);
-        }
-        for obstacle in &scene.obstacles {
-            let colour = if obstacle.movable { MOVABLE } else { OBSTACLE };
-            fill_body(pixmap, obstacle, colour, view);
+        for obstacle in scene.obstacles.iter().filter(|o| !o.movable) {
+            fill_body(pixmap, obstacle, OBSTACLE, view);
         }
         for light in &scene.lights {
             let [r, g, b] = light.colour;
@@ -179,10 +172,11 @@ impl Painter {
 
     /// Draws the `robots` of one frame over the background, with a progress bar `progress` (0 to 1) long, and
     /// answers the picture: RGBA, opaque, row by row from the top.
-    pub fn draw(&mut self, robots: &[FrameRobot], progress: f32) -> &[u8] {
+    pub fn draw(&mut self, robots: &[FrameRobot], places: &ObjectPlaces, progress: f32) -> &[u8] {
         self.canvas
             .data_mut()
             .copy_from_slice(self.background.data());
+        self.draw_objects(places);
         if self.trails.len() == TRAIL_SAMPLES {
             self.trails.pop_front();
         }
@@ -195,6 +189,42 @@ impl Painter {
         }
         self.draw_progress(progress);
         self.canvas.data()
+    }
+
+    /// Targets and movable obstacles where `places` puts them (where the scene placed those without a row); a
+    /// target out of the arena is not drawn.
+    fn draw_objects(&mut self, places: &ObjectPlaces) {
+        let (canvas, scene, view) = (&mut self.canvas, &self.scene, self.view);
+        let moved =
+            |body: &Body, place: Option<&Option<ObjectPlace>>| match place.copied().flatten() {
+                None => Some(body.clone()),
+                Some(p) if p.in_arena => Some(Body {
+                    x: p.x,
+                    y: p.y,
+                    angle: p.angle,
+                    ..body.clone()
+                }),
+                Some(_) => None,
+            };
+        for (index, target) in scene.targets.iter().enumerate() {
+            let colour = target
+                .colour
+                .filter(|&c| c != [0; 3])
+                .map_or(TARGET, |[r, g, b]| [r, g, b, 255]);
+            if let Some(body) = moved(target, places.targets.get(index)) {
+                fill_body(canvas, &body, colour, view);
+            }
+        }
+        for (index, obstacle) in scene
+            .obstacles
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.movable)
+        {
+            if let Some(body) = moved(obstacle, places.obstacles.get(index)) {
+                fill_body(canvas, &body, MOVABLE, view);
+            }
+        }
     }
 
     fn draw_trails(&mut self) {

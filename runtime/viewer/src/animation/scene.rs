@@ -61,7 +61,7 @@ pub struct Robot {
 }
 
 /// An obstacle or a target as placed.
-#[derive(Deserialize)]
+#[derive(Clone, Deserialize)]
 pub struct Body {
     /// Centre x in metres.
     pub x: f32,
@@ -81,7 +81,7 @@ pub struct Body {
 }
 
 /// A body's outline.
-#[derive(Deserialize)]
+#[derive(Clone, Copy, Deserialize)]
 #[serde(tag = "shape", rename_all = "lowercase")]
 pub enum Shape {
     /// A disc.
