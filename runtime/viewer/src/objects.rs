@@ -6,6 +6,7 @@ use std::path::Path;
 use serde_json::{Value, json};
 
 use crate::lines::GrowingLines;
+use crate::trajectory::number;
 
 /// The header this version writes (docs/records.md).
 pub const HEADER: &str = "tick,kind,index,id,x,y,angle,in_arena";
@@ -161,12 +162,6 @@ impl Table {
         );
         Ok(())
     }
-}
-
-fn number<T: std::str::FromStr>(text: &str, name: &str) -> Result<T, String> {
-    text.parse().map_err(|_| {
-        format!("`{text}` in the `{name}` column is not a number of that column's kind")
-    })
 }
 
 #[cfg(test)]

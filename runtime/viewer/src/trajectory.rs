@@ -213,7 +213,8 @@ fn field<'a>(fields: &mut impl Iterator<Item = &'a str>, name: &str) -> Result<&
         .ok_or_else(|| format!("the row ends before its `{name}` column"))
 }
 
-fn number<T: std::str::FromStr>(text: &str, name: &str) -> Result<T, String> {
+/// `text` read as a number of the record column `name`, or a sentence saying it is not one.
+pub(crate) fn number<T: std::str::FromStr>(text: &str, name: &str) -> Result<T, String> {
     text.parse().map_err(|_| {
         format!("`{text}` in the `{name}` column is not a number of that column's kind")
     })
