@@ -8,6 +8,7 @@
 use super::background::RowWriter;
 use super::events::{EventRow, EventsWriter};
 use super::messages::MessagesWriter;
+use super::objects_file::{ObjectRow, ObjectsWriter};
 use super::trajectory::{PoseRow, TrajectoryWriter};
 use crate::error::WorldError;
 use crate::media::mail::MessageRecord;
@@ -21,6 +22,8 @@ pub enum RecordRow {
     Pose(PoseRow),
     /// A row of `messages.csv`.
     Message(MessageRecord),
+    /// A row of `objects.csv`.
+    Object(ObjectRow),
 }
 
 /// Both files.
@@ -31,6 +34,8 @@ pub struct RecordFiles {
     pub trajectory: TrajectoryWriter,
     /// `messages.csv`, in runs with a messages medium.
     pub messages: Option<MessagesWriter>,
+    /// `objects.csv`, in runs with targets or movable obstacles.
+    pub objects: Option<ObjectsWriter>,
 }
 
 impl RowWriter for RecordFiles {
@@ -46,11 +51,19 @@ impl RowWriter for RecordFiles {
                         messages.write_row(row)?;
                     }
                 }
+                RecordRow::Object(row) => {
+                    if let Some(objects) = &mut self.objects {
+                        objects.write_row(row)?;
+                    }
+                }
             }
         }
         self.events.flush()?;
         if let Some(messages) = &mut self.messages {
             messages.flush()?;
+        }
+        if let Some(objects) = &mut self.objects {
+            objects.flush()?;
         }
         self.trajectory.flush()
     }

@@ -41,7 +41,7 @@ pub struct Recorder {
     files: Background<RecordFiles>,
     snapshot_ticks: BTreeSet<u64>,
     loop_output: Option<LoopOutput>,
-    objects: Option<objects_file::ObjectsFile>,
+    object_moves: Option<objects_file::ObjectMoves>,
     pheromone: Option<pheromone_file::PheromoneFile>,
     trails: trails::Trails,
 }
@@ -78,6 +78,8 @@ impl Recorder {
             path: dir.to_path_buf(),
             source,
         })?;
+        let (object_moves, objects) =
+            objects_file::ObjectsWriter::create(dir, &world.arena)?.unzip();
         let files = RecordFiles {
             events: EventsWriter::create(dir, &world.arena, world.coordinators())?,
             trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
@@ -85,8 +87,8 @@ impl Recorder {
                 .has_mail()
                 .then(|| messages::MessagesWriter::create(dir))
                 .transpose()?,
+            objects,
         };
-        let objects = objects_file::ObjectsFile::create(dir, &world.arena)?;
         let pheromone = pheromone_file::PheromoneFile::create(dir, &world.arena)?;
         let pheromone_entry = pheromone
             .as_ref()
@@ -112,7 +114,7 @@ impl Recorder {
             files: Background::spawn(dir, files)?,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
             loop_output,
-            objects,
+            object_moves,
             pheromone,
             trails: trails::Trails::default(),
         })
@@ -157,8 +159,8 @@ impl Recorder {
         if let Some(pheromone) = &mut self.pheromone {
             pheromone.record(&world.arena)?;
         }
-        if let Some(objects) = &mut self.objects {
-            objects.record(&world.arena)?;
+        if let Some(moves) = &mut self.object_moves {
+            moves.changes(&world.arena, |row| self.files.push(RecordRow::Object(row)));
         }
         let tick = world.tick();
         for event in &world.arena.gripper_events {

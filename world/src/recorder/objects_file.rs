@@ -1,6 +1,9 @@
 //! `objects.csv`: where the targets and the movable obstacles are, for replays. A row for every such object at
 //! tick 0, then one whenever an object moved (more than half a millimetre or a milliradian) or entered or left the
 //! arena (a target picked up, put down or removed), so that still objects cost nothing.
+//!
+//! The tick loop only compares poses and hands the changed ones over as plain rows ([`ObjectMoves`]); the
+//! recorder's thread formats and writes them ([`ObjectsWriter`]), as it does the other per-tick files.
 
 use std::path::Path;
 
@@ -20,16 +23,25 @@ pub const OBJECTS_HEADER: &str = "tick,kind,index,id,x,y,angle,in_arena";
 const MIN_MOVE_M: f32 = 5e-4;
 const MIN_TURN_RAD: f32 = 1e-3;
 
-/// An object's last written pose and presence.
-#[derive(Clone, Copy, PartialEq)]
-struct Written {
+/// Which list of the scene an object is in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjectKind {
+    /// A target.
+    Target,
+    /// A movable obstacle.
+    Obstacle,
+}
+
+/// An object's pose and presence.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Place {
     x: f32,
     y: f32,
     angle: f32,
     in_arena: bool,
 }
 
-impl Written {
+impl Place {
     fn of(placed: &Placed, in_arena: bool) -> Self {
         Self {
             x: placed.position.x,
@@ -39,23 +51,87 @@ impl Written {
         }
     }
 
-    fn differs(&self, other: &Written) -> bool {
+    fn differs(&self, other: &Place) -> bool {
         self.in_arena != other.in_arena
             || (self.x - other.x).hypot(self.y - other.y) > MIN_MOVE_M
             || (self.angle - other.angle).abs() > MIN_TURN_RAD
     }
 }
 
-/// The open file and what it last said of each object.
-pub struct ObjectsFile {
-    file: CsvFile,
-    targets: Vec<Option<Written>>,
-    obstacles: Vec<Option<Written>>,
+/// One row of `objects.csv`, before formatting.
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectRow {
+    tick: u64,
+    kind: ObjectKind,
+    index: u32,
+    place: Place,
 }
 
-impl ObjectsFile {
-    /// Creates the file in `dir` when the arena has targets or movable obstacles.
-    pub fn create(dir: &Path, arena: &Arena) -> Result<Option<Self>, WorldError> {
+/// What was last written of each object; finds the objects that changed in a tick.
+pub struct ObjectMoves {
+    targets: Vec<Option<Place>>,
+    obstacles: Vec<Option<Place>>,
+}
+
+impl ObjectMoves {
+    /// Hands a row to `rows` for every object that changed since its last row (every object at the first call).
+    pub fn changes(&mut self, arena: &Arena, mut rows: impl FnMut(ObjectRow)) {
+        let targets = arena
+            .targets
+            .iter()
+            .map(|t| Some(Place::of(&t.placed, t.state == TargetState::InArena)));
+        changed(
+            &mut self.targets,
+            targets,
+            ObjectKind::Target,
+            arena.tick,
+            &mut rows,
+        );
+        let obstacles = arena.obstacles.iter().map(|o| {
+            matches!(o.motion, Motion::Movable { .. }).then(|| Place::of(&o.placed, true))
+        });
+        changed(
+            &mut self.obstacles,
+            obstacles,
+            ObjectKind::Obstacle,
+            arena.tick,
+            &mut rows,
+        );
+    }
+}
+
+/// Compares each object's place now (`None`: not tracked) with its last row and records the changes.
+fn changed(
+    last: &mut [Option<Place>],
+    now: impl Iterator<Item = Option<Place>>,
+    kind: ObjectKind,
+    tick: u64,
+    rows: &mut impl FnMut(ObjectRow),
+) {
+    for (index, (last, now)) in last.iter_mut().zip(now).enumerate() {
+        let Some(now) = now else { continue };
+        if last.is_none_or(|l| l.differs(&now)) {
+            *last = Some(now);
+            rows(ObjectRow {
+                tick,
+                kind,
+                index: index as u32,
+                place: now,
+            });
+        }
+    }
+}
+
+/// Writes `objects.csv` on the recorder's thread.
+pub struct ObjectsWriter {
+    file: CsvFile,
+    target_ids: Vec<String>,
+    obstacle_ids: Vec<String>,
+}
+
+impl ObjectsWriter {
+    /// Creates the file in `dir` and the tracker of its rows, when the arena has targets or movable obstacles.
+    pub fn create(dir: &Path, arena: &Arena) -> Result<Option<(ObjectMoves, Self)>, WorldError> {
         let movable = arena
             .obstacles
             .iter()
@@ -63,66 +139,43 @@ impl ObjectsFile {
         if arena.targets.is_empty() && !movable {
             return Ok(None);
         }
-        Ok(Some(Self {
-            file: CsvFile::create(&dir.join(OBJECTS_FILE), OBJECTS_HEADER, 1 << 12)?,
+        let moves = ObjectMoves {
             targets: vec![None; arena.targets.len()],
             obstacles: vec![None; arena.obstacles.len()],
-        }))
+        };
+        let writer = Self {
+            file: CsvFile::create(&dir.join(OBJECTS_FILE), OBJECTS_HEADER, 1 << 12)?,
+            target_ids: arena.targets.iter().map(|t| t.name.clone()).collect(),
+            obstacle_ids: arena.obstacles.iter().map(|o| o.name.clone()).collect(),
+        };
+        Ok(Some((moves, writer)))
     }
 
-    /// Writes the rows of the objects that changed since they were last written, and flushes.
-    pub fn record(&mut self, arena: &Arena) -> Result<(), WorldError> {
-        let tick = arena.tick;
-        for (index, target) in arena.targets.iter().enumerate() {
-            let now = Written::of(&target.placed, target.state == TargetState::InArena);
-            if let Some(last) = self.targets.get_mut(index)
-                && last.is_none_or(|l| l.differs(&now))
-            {
-                *last = Some(now);
-                write_row(&mut self.file, tick, "target", index, &target.name, &now)?;
-            }
-        }
-        for (index, obstacle) in arena.obstacles.iter().enumerate() {
-            if !matches!(obstacle.motion, Motion::Movable { .. }) {
-                continue;
-            }
-            let now = Written::of(&obstacle.placed, true);
-            if let Some(last) = self.obstacles.get_mut(index)
-                && last.is_none_or(|l| l.differs(&now))
-            {
-                *last = Some(now);
-                write_row(
-                    &mut self.file,
-                    tick,
-                    "obstacle",
-                    index,
-                    &obstacle.name,
-                    &now,
-                )?;
-            }
-        }
+    /// Formats `row` into the file's buffer.
+    pub fn write_row(&mut self, row: &ObjectRow) -> Result<(), WorldError> {
+        let (kind, ids) = match row.kind {
+            ObjectKind::Target => ("target", &self.target_ids),
+            ObjectKind::Obstacle => ("obstacle", &self.obstacle_ids),
+        };
+        let id = ids.get(row.index as usize).map_or("", String::as_str);
+        let place = row.place;
+        let written = self
+            .file
+            .line()
+            .int(row.tick)
+            .and_then(|l| l.text(kind))
+            .and_then(|l| l.int(row.index))
+            .and_then(|l| l.text(id))
+            .and_then(|l| l.float(place.x))
+            .and_then(|l| l.float(place.y))
+            .and_then(|l| l.float(place.angle))
+            .and_then(|l| l.int(u8::from(place.in_arena)))
+            .and_then(|l| l.end());
+        written.map_err(|source| self.file.error(source))
+    }
+
+    /// Writes the buffer to the file.
+    pub fn flush(&mut self) -> Result<(), WorldError> {
         self.file.flush()
     }
-}
-
-fn write_row(
-    file: &mut CsvFile,
-    tick: u64,
-    kind: &str,
-    index: usize,
-    id: &str,
-    at: &Written,
-) -> Result<(), WorldError> {
-    let written = file
-        .line()
-        .int(tick)
-        .and_then(|l| l.text(kind))
-        .and_then(|l| l.int(index))
-        .and_then(|l| l.text(id))
-        .and_then(|l| l.float(at.x))
-        .and_then(|l| l.float(at.y))
-        .and_then(|l| l.float(at.angle))
-        .and_then(|l| l.int(u8::from(at.in_arena)))
-        .and_then(|l| l.end());
-    written.map_err(|source| file.error(source))
 }

@@ -4,7 +4,8 @@
 //! The file is a sequence of equal frames: the tick (`u64`, little-endian), then per channel, per row from the
 //! arena's minimum y up, per column one byte, the concentration clamped to [0, 1] times 255. The grid's size, the
 //! period and the channel colours are in `scene.json` (`pheromone`). A frame is written whole and flushed, so a
-//! cut file ends with whole frames plus at most one partial one, which readers ignore.
+//! cut file ends with whole frames plus at most one partial one, which readers ignore. It is written on the tick
+//! thread, as the loop functions' output is: once a simulated second, a frame's copy would cost what its write does.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
