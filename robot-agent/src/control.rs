@@ -97,15 +97,19 @@ impl Control {
 /// Loads (or synthesises) the supervisor set of a supervised plan; `None` for a native controller.
 pub fn supervisor_set(plan: &Plan) -> Result<Option<SupervisorSet>, BuildError> {
     match plan {
-        Plan::Supervised { supervisors, .. } => load_set(supervisors).map(Some),
+        Plan::Supervised {
+            supervisors,
+            reduce,
+            ..
+        } => load_set(supervisors, *reduce).map(Some),
         Plan::Native { .. } => Ok(None),
     }
 }
 
-fn load_set(source: &Supervisors) -> Result<SupervisorSet, BuildError> {
+fn load_set(source: &Supervisors, reduce: bool) -> Result<SupervisorSet, BuildError> {
     let loaded = match source {
-        Supervisors::Builtin(_, models) => supervisors::synthesise(models),
-        Supervisors::Files(files) => supervisors::load(files),
+        Supervisors::Builtin(_, models) => supervisors::synthesise_with(models, reduce),
+        Supervisors::Files(files) => supervisors::load_with(files, reduce),
     };
     loaded.map_err(|problem| BuildError::Supervisors {
         where_: source.to_string(),
@@ -125,9 +129,10 @@ pub fn build(
         Plan::Supervised {
             profile,
             supervisors,
+            reduce,
         } => {
             let where_ = supervisors.to_string();
-            let set = load_set(supervisors)?;
+            let set = load_set(supervisors, *reduce)?;
             let params = params.clone().with_run_seed(run_seed);
             let callbacks = profiles::bind_profile(profile, &params, &set.events)?;
             info!(
@@ -165,6 +170,7 @@ mod tests {
         let plan = Plan::Supervised {
             profile: "obstacle_avoidance".to_owned(),
             supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
+            reduce: false,
         };
         assert!(matches!(
             build(&plan, &Params::default(), 1, 0),
@@ -177,6 +183,7 @@ mod tests {
         let plan = Plan::Supervised {
             profile: "obstacle_avoidance_sct".to_owned(),
             supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
+            reduce: false,
         };
         let err = build(&plan, &Params::default(), 1, 0).err().unwrap();
         assert!(matches!(err, BuildError::Profile(ProfileError::Bind(_))));
@@ -187,6 +194,7 @@ mod tests {
         let plan = Plan::Supervised {
             profile: "obstacle_avoidance".to_owned(),
             supervisors: Supervisors::Files(vec!["/nonexistent/oa.sup".into()]),
+            reduce: false,
         };
         let err = build(&plan, &Params::default(), 1, 0)
             .err()

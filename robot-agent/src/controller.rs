@@ -7,7 +7,8 @@
 //! at startup, or one compiled supervisor file; relative to the config file). Either param alone completes the
 //! built-in of the element name (its profile, or its supervisors). Controllers without these params are looked
 //! up by element name (ARGoS style): the thesis' and ARGoS' controller names map to built-ins, and a native
-//! controller's own name selects it.
+//! controller's own name selects it. A supervised controller may also say `reduce_supervisors="true"` (default
+//! `false`): supervisors synthesised from models are then reduced (supervisor-gen's `synth --reduce`).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -30,6 +31,8 @@ pub enum Plan {
         profile: String,
         /// The supervisors.
         supervisors: Supervisors,
+        /// Reduce supervisors synthesised from models (`reduce_supervisors`).
+        reduce: bool,
     },
     /// A native controller.
     Native {
@@ -69,7 +72,14 @@ impl fmt::Display for Plan {
             Plan::Supervised {
                 profile,
                 supervisors,
-            } => write!(f, "profile `{profile}` with supervisors {supervisors}"),
+                reduce,
+            } => {
+                write!(f, "profile `{profile}` with supervisors {supervisors}")?;
+                if *reduce {
+                    write!(f, " (reduced)")?;
+                }
+                Ok(())
+            }
             Plan::Native { name } => write!(f, "native controller `{name}`"),
         }
     }
@@ -88,6 +98,7 @@ const BUILTINS: &[Builtin] = &[
         plan: || Plan::Supervised {
             profile: <ObstacleAvoidance as Profile>::NAME.to_owned(),
             supervisors: Supervisors::Builtin("obstacle_avoidance/ptsct", OBSTACLE_AVOIDANCE_PTSCT),
+            reduce: false,
         },
     },
     Builtin {
@@ -157,6 +168,26 @@ pub enum PlanError {
         /// The param missing.
         missing: &'static str,
     },
+    /// `reduce_supervisors` is neither `true` nor `false`.
+    #[error("parameter `{REDUCE_SUPERVISORS}` = \"{value}\" must be `true` or `false`")]
+    BadReduce {
+        /// The value given.
+        value: String,
+    },
+}
+
+/// The `<params>` attribute that asks for reduced supervisors.
+pub const REDUCE_SUPERVISORS: &str = "reduce_supervisors";
+
+/// The value of `reduce_supervisors` (`false` when absent).
+fn reduce_param(params: &Params) -> Result<bool, PlanError> {
+    match params.get(REDUCE_SUPERVISORS).map(str::trim) {
+        None | Some("false") => Ok(false),
+        Some("true") => Ok(true),
+        Some(other) => Err(PlanError::BadReduce {
+            value: other.to_owned(),
+        }),
+    }
 }
 
 /// The names a controller element may have without `profile`/`supervisors` params.
@@ -181,7 +212,7 @@ pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, Pla
         .filter(|f| !f.is_empty())
         .map(|f| base_dir.join(f))
         .collect();
-    let plan = match (params.get("profile"), files.is_empty()) {
+    let mut plan = match (params.get("profile"), files.is_empty()) {
         (Some(profile), _) if !profiles::is_profile(profile) => {
             return Err(PlanError::UnknownProfile {
                 name: profile.to_owned(),
@@ -191,11 +222,13 @@ pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, Pla
         (Some(profile), false) => Plan::Supervised {
             profile: profile.to_owned(),
             supervisors: Supervisors::Files(files),
+            reduce: false,
         },
         (Some(profile), true) => match builtin {
             Some(Plan::Supervised { supervisors, .. }) => Plan::Supervised {
                 profile: profile.to_owned(),
                 supervisors,
+                reduce: false,
             },
             _ => {
                 return Err(PlanError::Incomplete {
@@ -208,6 +241,7 @@ pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, Pla
             Some(Plan::Supervised { profile, .. }) => Plan::Supervised {
                 profile,
                 supervisors: Supervisors::Files(files),
+                reduce: false,
             },
             _ => {
                 return Err(PlanError::Incomplete {
@@ -229,6 +263,10 @@ pub fn plan(element: &str, params: &Params, base_dir: &Path) -> Result<Plan, Pla
             }
         },
     };
+    // Read for supervised controllers only, so that a native controller reports it as unused.
+    if let Plan::Supervised { reduce, .. } = &mut plan {
+        *reduce = reduce_param(params)?;
+    }
     if BUILTINS.iter().any(|b| b.element == element) {
         info!("controller element `{element}` maps to {plan}");
     }
@@ -255,6 +293,7 @@ mod tests {
                     "obstacle_avoidance/ptsct",
                     OBSTACLE_AVOIDANCE_PTSCT
                 ),
+                reduce: false,
             }
         );
     }
@@ -298,8 +337,39 @@ mod tests {
             Plan::Supervised {
                 profile: "obstacle_avoidance".to_owned(),
                 supervisors: Supervisors::Files(vec![PathBuf::from("/cfg/oa/models/ptsct")]),
+                reduce: false,
             }
         );
+    }
+
+    #[test]
+    fn reduce_supervisors_is_read_for_supervised_controllers_only() {
+        let supervised = |value: &str| {
+            let params = Params::new([
+                ("profile", "obstacle_avoidance"),
+                ("supervisors", "models/ptsct"),
+                (REDUCE_SUPERVISORS, value),
+            ]);
+            plan("c", &params, Path::new("/cfg")).map(|p| p.to_string())
+        };
+        assert_eq!(
+            supervised("true").unwrap(),
+            "profile `obstacle_avoidance` with supervisors /cfg/models/ptsct (reduced)"
+        );
+        assert_eq!(
+            supervised(" false ").unwrap(),
+            "profile `obstacle_avoidance` with supervisors /cfg/models/ptsct"
+        );
+        assert_eq!(
+            supervised("yes").unwrap_err().to_string(),
+            "parameter `reduce_supervisors` = \"yes\" must be `true` or `false`"
+        );
+        let native = Params::new([(REDUCE_SUPERVISORS, "true")]);
+        assert!(matches!(
+            plan("epuck_obstacleavoidance", &native, Path::new("/c")),
+            Ok(Plan::Native { .. })
+        ));
+        assert_eq!(native.unread(), [(REDUCE_SUPERVISORS, None)]);
     }
 
     #[test]

@@ -2,8 +2,10 @@
 //! the models built into this binary.
 //!
 //! Models go through supervisor-gen's library exactly as `supervisor-gen synth` would take them: read, validate
-//! (every located diagnostic reported at once), local-modular synthesis, minimisation, compilation. This module
-//! runs only at startup; it never touches the tick loop.
+//! (every located diagnostic reported at once), local-modular synthesis, minimisation, compilation; and, when the
+//! controller asks for it (`reduce_supervisors="true"`), supervisor reduction as `supervisor-gen synth --reduce`
+//! does it: every reduction checked against the unreduced closed loop, used only where the set shrinks, with the
+//! plant observers the reduced supervisors need. This module runs only at startup; it never touches the tick loop.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -13,10 +15,11 @@ use swarm_contract::supervisor_gen::compiled::{CodegenError, CompiledFormatError
 use swarm_contract::supervisor_gen::convert::{ConvertError, to_project};
 use swarm_contract::supervisor_gen::diagnostics::{Diagnostic, has_errors};
 use swarm_contract::supervisor_gen::pipeline::{SynthesisError, SynthesisOptions, synthesize};
+use swarm_contract::supervisor_gen::reduce::{ReduceError, ReduceLimits, reduce_synthesis};
 use swarm_contract::supervisor_gen::validate::{ValidateOptions, validate};
 use swarm_contract::supervisor_gen::xml_read::read_model;
 use thiserror::Error;
-use tracing::warn;
+use tracing::{info, warn};
 
 /// One model file: the name diagnostics use, and its text.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,6 +104,9 @@ pub enum SupervisorError {
     /// The supervisors exceed the compiled layout's limits.
     #[error(transparent)]
     Codegen(#[from] CodegenError),
+    /// A reduced supervisor failed its equivalence check (it is never used).
+    #[error(transparent)]
+    Reduction(#[from] ReduceError),
     /// A compiled supervisor file is unreadable or malformed.
     #[error(transparent)]
     Compiled(#[from] CompiledFormatError),
@@ -109,6 +115,12 @@ pub enum SupervisorError {
 /// Loads a supervisor set from `files`: XML model files, or one folder of them (synthesised local-modular), or
 /// one compiled supervisor-set file.
 pub fn load(files: &[PathBuf]) -> Result<SupervisorSet, SupervisorError> {
+    load_with(files, false)
+}
+
+/// Like [`load`]; with `reduce`, supervisors synthesised from models are reduced. A compiled file is loaded as it
+/// was written (reduced or not when it was compiled, e.g. by the launcher's `--check --write-supervisors`).
+pub fn load_with(files: &[PathBuf], reduce: bool) -> Result<SupervisorSet, SupervisorError> {
     let is_xml = |p: &Path| p.extension().is_some_and(|x| x == "xml");
     let models: Vec<PathBuf> = match files {
         [] => return Err(SupervisorError::NoFiles),
@@ -140,7 +152,7 @@ pub fn load(files: &[PathBuf]) -> Result<SupervisorSet, SupervisorError> {
         .iter()
         .map(|(file, text)| ModelText { file, text })
         .collect();
-    synthesise(&models)
+    synthesise_with(&models, reduce)
 }
 
 /// The `.xml` files of folder `dir`, sorted by name.
@@ -166,6 +178,14 @@ fn models_in(dir: &Path) -> Result<Vec<PathBuf>, SupervisorError> {
 
 /// Validates `models` and synthesises their local-modular supervisor set.
 pub fn synthesise(models: &[ModelText<'_>]) -> Result<SupervisorSet, SupervisorError> {
+    synthesise_with(models, false)
+}
+
+/// Like [`synthesise`]; with `reduce`, the set is reduced (see the module documentation).
+pub fn synthesise_with(
+    models: &[ModelText<'_>],
+    reduce: bool,
+) -> Result<SupervisorSet, SupervisorError> {
     let mut problems = Vec::new();
     let mut sources = Vec::with_capacity(models.len());
     for m in models {
@@ -192,7 +212,20 @@ pub fn synthesise(models: &[ModelText<'_>]) -> Result<SupervisorSet, SupervisorE
         ..SynthesisOptions::default()
     };
     let synthesis = synthesize(&project, Architecture::LocalModular, options)?;
-    Ok(synthesis.compile()?)
+    if !reduce {
+        return Ok(synthesis.compile()?);
+    }
+    let reduction = reduce_synthesis(&synthesis, ReduceLimits::default())?;
+    for w in reduction.warnings() {
+        warn!("{w}");
+    }
+    info!(
+        mem_cons_before = reduction.mem_cons_before,
+        mem_cons_after = reduction.mem_cons_after,
+        observers = reduction.observers.len(),
+        "supervisors reduced"
+    );
+    Ok(reduction.compile(&synthesis.normalised.events)?)
 }
 
 #[cfg(test)]
@@ -219,6 +252,33 @@ mod tests {
                 ("turn-right", true),
             ]
         );
+    }
+
+    #[test]
+    fn reduced_synchronisation_supervisors_are_smaller_and_bind_the_same_events() {
+        let models = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs/synchronisation/models/ptsct");
+        let plain = load(std::slice::from_ref(&models)).unwrap();
+        let reduced = load_with(&[models], true).unwrap();
+        assert_eq!((plain.mem_cons(), reduced.mem_cons()), (140, 137));
+        assert_eq!(reduced.events, plain.events);
+        let states = |set: &SupervisorSet| -> Vec<(String, usize)> {
+            set.supervisors
+                .iter()
+                .map(|s| (s.name.clone(), s.states.len()))
+                .collect()
+        };
+        assert_eq!(
+            states(&reduced),
+            [
+                ("S_E1".to_owned(), 5),
+                ("S_E2a".to_owned(), 2),
+                ("S_E2b".to_owned(), 2)
+            ]
+        );
+        // Nothing pays for the obstacle-avoidance models: the reduced set is the set.
+        let builtin = synthesise_with(OBSTACLE_AVOIDANCE_PTSCT, true).unwrap();
+        assert_eq!(builtin, synthesise(OBSTACLE_AVOIDANCE_PTSCT).unwrap());
     }
 
     #[test]

@@ -25,6 +25,7 @@ pub mod normalise;
 pub mod pipeline;
 pub mod product;
 pub mod progress;
+pub mod reduce;
 pub mod report;
 pub mod source;
 pub mod supc;

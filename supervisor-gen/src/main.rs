@@ -1,7 +1,7 @@
 //! `supervisor-gen` command line: validate, synthesise, draw and compile ptSCT supervisors.
 //!
 //! Exit codes: 0 success; 1 invalid input (any validation error) or an impossible specification; 2 usage or I/O
-//! problems. Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
+//! problems; 3 a reduced supervisor failed its equivalence check (`synth --reduce`; nothing is written). Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
 
 use std::collections::HashMap;
 use std::io::IsTerminal;
@@ -22,7 +22,10 @@ use supervisor_gen::diagnostics::{Diagnostic, Severity};
 use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels, StateMark};
 use supervisor_gen::load::{Input, load};
 use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
-use supervisor_gen::report::{Report, SkippedOutput};
+use supervisor_gen::reduce::{
+    ReduceLimits, Reduction, ReductionOutcome, SupervisorReduction, reduce_synthesis,
+};
+use supervisor_gen::report::{ReductionFiles, Report, SkippedOutput};
 use supervisor_gen::supc::RemovalReason;
 use supervisor_gen::validate::{CheckedModel, ValidateOptions};
 use supervisor_gen::xml_write::to_xml;
@@ -31,7 +34,8 @@ use supervisor_gen::xml_write::to_xml;
 ///
 /// Model files are plain paths (no globs): the thesis XML format (`<automata>`) or Nadzoru2 FSA files
 /// (`<model type="FSA">`), told apart by their root element.
-/// Exit codes: 0 success, 1 invalid input or impossible specification, 2 usage or I/O error.
+/// Exit codes: 0 success, 1 invalid input or impossible specification, 2 usage or I/O error, 3 a reduced supervisor
+/// failed its equivalence check (`synth --reduce`).
 #[derive(Debug, Parser)]
 #[command(
     name = "supervisor-gen",
@@ -86,6 +90,10 @@ struct SynthArgs {
     /// Also draw every input, intermediate (G, E, K, SupC) and final supervisor into DIR/drawings.
     #[arg(long)]
     draw: bool,
+    /// Reduce every supervisor (control congruence, Su and Wonham), check each reduction against the unreduced
+    /// closed loop, and write the reduced set with the plant observers it needs; exit 3 if a check fails.
+    #[arg(long)]
+    reduce: bool,
     #[command(flatten)]
     images: ImageArgs,
 }
@@ -185,6 +193,8 @@ enum Outcome {
     Success,
     /// Invalid input or an impossible specification (already explained on stderr).
     Rejected,
+    /// A reduced supervisor failed its equivalence check (already explained on stderr).
+    ReductionRefused,
 }
 
 fn main() -> ExitCode {
@@ -208,6 +218,7 @@ fn main() -> ExitCode {
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::Rejected) => ExitCode::from(1),
+        Ok(Outcome::ReductionRefused) => ExitCode::from(3),
         Err(err) => {
             eprintln!("error: {err:#}");
             ExitCode::from(2)
@@ -371,7 +382,7 @@ fn codegen(args: &CodegenArgs) -> Result<Outcome> {
     let Some(Built { synthesis, set, .. }) = built(&args.project)? else {
         return Ok(Outcome::Rejected);
     };
-    let origin = origin(&args.project, synthesis.architecture);
+    let origin = origin(&args.project, synthesis.architecture, false);
     write(&args.out, generate_rust(&set, &origin))?;
     println!(
         "{} supervisor(s), MemCons {} bytes: {}",
@@ -390,37 +401,25 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
     else {
         return Ok(Outcome::Rejected);
     };
+    // Every reduction is checked before anything is written: a refused one leaves no output behind.
+    let limits = ReduceLimits::default();
+    let reduction = match args.reduce.then(|| reduce_synthesis(&synthesis, limits)) {
+        None => None,
+        Some(Ok(reduction)) => Some(reduction),
+        Some(Err(err)) => {
+            terminal_progress::finish();
+            eprintln!("error: {err}");
+            return Ok(Outcome::ReductionRefused);
+        }
+    };
     let out = &args.out;
     create_dir(out)?;
     let events = &synthesis.normalised.events;
-    let mut files = Vec::new();
-    for s in &synthesis.supervisors {
-        let file = format!("{}.xml", dot::file_stem(&s.name));
-        write(&out.join(&file), to_xml(&s.supervisor, events))?;
-        files.push(file);
-    }
+    let files = write_supervisors_xml(out, &synthesis, reduction.as_ref())?;
     // A result is never lost: a set too large for the compiled format skips only the compiled outputs.
     let mut skipped = Vec::new();
-    let (bytes_written, mem_cons) = match synthesis.compile() {
-        Ok(set) => {
-            let bytes = set.to_bytes();
-            write(&out.join("supervisors.ptsct"), &bytes)?;
-            write(
-                &out.join("supervisors.rs"),
-                generate_rust(&set, &origin(&args.project, synthesis.architecture)),
-            )?;
-            (bytes.len(), set.mem_cons())
-        }
-        Err(err) => {
-            for output in ["supervisors.ptsct", "supervisors.rs"] {
-                skipped.push(SkippedOutput {
-                    output: output.to_owned(),
-                    reason: format!("V15: {err}"),
-                });
-            }
-            (0, synthesis.mem_cons)
-        }
-    };
+    let (bytes_written, mem_cons) =
+        write_compiled(args, &synthesis, reduction.as_ref(), &mut skipped)?;
     if args.draw {
         let dir = out.join("drawings");
         create_dir(&dir)?;
@@ -430,27 +429,130 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
             images: args.images.images(),
             skipped: Vec::new(),
         };
-        draw_synthesis(&mut drawer, &synthesis)?;
+        draw_synthesis(&mut drawer, &synthesis, reduction.as_ref())?;
         skipped.extend(drawer.skipped.into_iter().map(|s| SkippedOutput {
             output: format!("drawings/{}", s.output),
             ..s
         }));
     }
-    let mut report = Report::new(&synthesis, &files, bytes_written, &warnings);
+    let mut report = Report::new(&synthesis, &files.supervisors, bytes_written, &warnings);
+    if let Some(r) = &reduction {
+        let files = ReductionFiles {
+            reduced: &files.reduced,
+            observers: &files.observers,
+        };
+        report = report.with_reduction(r, events, files, limits, bytes_written);
+    }
     report.skipped = skipped;
     write(
         &out.join("report.json"),
         report.to_json().context("cannot serialise the report")?,
     )?;
-    print_summary(&synthesis, mem_cons, out);
+    print_summary(&synthesis, reduction.as_ref(), mem_cons, out);
     for s in &report.skipped {
         eprintln!("warning: {} not written: {}", s.output, s.reason);
     }
     Ok(Outcome::Success)
 }
 
+/// The XML files `synth` wrote, relative to the output directory.
+struct XmlFiles {
+    /// One per supervisor, the one compiled: `<S>.xml`.
+    supervisors: Vec<String>,
+    /// One per reduction computed (with `--reduce`): `<S>.reduced.xml`.
+    reduced: Vec<String>,
+    /// One per plant observer (with `--reduce`): `observer_<plant>.xml`.
+    observers: Vec<String>,
+}
+
+/// Writes the supervisors (reduced where a reduction is used), every reduction and the observers as XML.
+fn write_supervisors_xml(
+    out: &Path,
+    synthesis: &Synthesis,
+    reduction: Option<&Reduction>,
+) -> Result<XmlFiles> {
+    let events = &synthesis.normalised.events;
+    let Some(r) = reduction else {
+        return Ok(XmlFiles {
+            supervisors: write_xml(out, &synthesis.final_supervisors(), "", "", events)?,
+            reduced: Vec::new(),
+            observers: Vec::new(),
+        });
+    };
+    let finals: Vec<Automaton> = r
+        .supervisors
+        .iter()
+        .map(|s| s.supervisor().clone())
+        .collect();
+    let reduced: Vec<Automaton> = r
+        .supervisors
+        .iter()
+        .filter_map(|s| s.reduced.clone())
+        .collect();
+    Ok(XmlFiles {
+        supervisors: write_xml(out, &finals, "", "", events)?,
+        reduced: write_xml(out, &reduced, "", ".reduced", events)?,
+        observers: write_xml(out, &r.observers, "observer_", "", events)?,
+    })
+}
+
+/// Writes `supervisors.ptsct` and `supervisors.rs` of the set (the reduced one with `--reduce`), or notes in
+/// `skipped` why they were not; returns the bytes written and the set's MemCons.
+fn write_compiled(
+    args: &SynthArgs,
+    synthesis: &Synthesis,
+    reduction: Option<&Reduction>,
+    skipped: &mut Vec<SkippedOutput>,
+) -> Result<(usize, usize)> {
+    let compiled = match reduction {
+        Some(r) => r.compile(&synthesis.normalised.events),
+        None => synthesis.compile(),
+    };
+    match compiled {
+        Ok(set) => {
+            let bytes = set.to_bytes();
+            write(&args.out.join("supervisors.ptsct"), &bytes)?;
+            let origin = origin(&args.project, synthesis.architecture, args.reduce);
+            write(
+                &args.out.join("supervisors.rs"),
+                generate_rust(&set, &origin),
+            )?;
+            Ok((bytes.len(), set.mem_cons()))
+        }
+        Err(err) => {
+            for output in ["supervisors.ptsct", "supervisors.rs"] {
+                skipped.push(SkippedOutput {
+                    output: output.to_owned(),
+                    reason: format!("V15: {err}"),
+                });
+            }
+            Ok((
+                0,
+                reduction.map_or(synthesis.mem_cons, |r| r.mem_cons_after),
+            ))
+        }
+    }
+}
+
+/// Writes each automaton as `<prefix><name><suffix>.xml` in `out`; returns the file names.
+fn write_xml(
+    out: &Path,
+    automata: &[Automaton],
+    prefix: &str,
+    suffix: &str,
+    events: &EventTable,
+) -> Result<Vec<String>> {
+    let mut files = Vec::with_capacity(automata.len());
+    for a in automata {
+        let file = format!("{prefix}{}{suffix}.xml", dot::file_stem(a.name()));
+        write(&out.join(&file), to_xml(a, events))?;
+        files.push(file);
+    }
+    Ok(files)
+}
+
 /// A one-line description of the inputs for the generated module's header.
-fn origin(args: &ProjectArgs, architecture: Architecture) -> String {
+fn origin(args: &ProjectArgs, architecture: Architecture, reduce: bool) -> String {
     let names = |paths: &[PathBuf]| {
         paths
             .iter()
@@ -464,13 +566,19 @@ fn origin(args: &ProjectArgs, architecture: Architecture) -> String {
             .join(" ")
     };
     format!(
-        "supervisor-gen synth --mode {architecture} --plant {} --spec {}",
+        "supervisor-gen synth --mode {architecture}{} --plant {} --spec {}",
+        if reduce { " --reduce" } else { "" },
         names(&args.plants),
         names(&args.specs)
     )
 }
 
-fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
+fn print_summary(
+    synthesis: &Synthesis,
+    reduction: Option<&Reduction>,
+    mem_cons: usize,
+    out: &Path,
+) {
     for s in &synthesis.supervisors {
         println!(
             "{}: {} states, {} transitions ({} controllable), {} events; {} state(s) of K removed",
@@ -504,29 +612,90 @@ fn print_summary(synthesis: &Synthesis, mem_cons: usize, out: &Path) {
             );
         }
     }
-    println!("MemCons {mem_cons} bytes; outputs in {}", out.display());
+    match reduction {
+        Some(r) => {
+            print_reduction(r);
+            println!(
+                "MemCons {mem_cons} bytes ({} unreduced); outputs in {}",
+                r.mem_cons_before,
+                out.display()
+            );
+        }
+        None => println!("MemCons {mem_cons} bytes; outputs in {}", out.display()),
+    }
+}
+
+/// One line per supervisor of a reduction, its observers and its warnings.
+fn print_reduction(reduction: &Reduction) {
+    for s in &reduction.supervisors {
+        let Some(reduced) = &s.reduced else {
+            println!("reduction: {} not reduced (see the warning)", s.name);
+            continue;
+        };
+        let what = match &s.outcome {
+            ReductionOutcome::Reduced => "reduced",
+            ReductionOutcome::NoGain => "kept, its reduction is no smaller",
+            ReductionOutcome::ObserversCostMore => {
+                "kept, the plant observers its reduction needs cost more"
+            }
+            ReductionOutcome::Skipped { .. } => "kept",
+        };
+        println!(
+            "reduction: {} {what}: {} -> {} states, {} -> {} transitions",
+            s.name,
+            s.original.state_count(),
+            reduced.state_count(),
+            s.original.transition_count(),
+            reduced.transition_count(),
+        );
+    }
+    if !reduction.observers.is_empty() {
+        let names: Vec<&str> = reduction.observers.iter().map(Automaton::name).collect();
+        println!(
+            "reduction: plant observers run with the reduced supervisors: {}",
+            names.join(", ")
+        );
+    }
+    println!(
+        "reduction: each reduction checked against the unreduced closed loop (language, marking, P, T, timers)"
+    );
+    for w in reduction.warnings() {
+        eprintln!("warning: {w}");
+    }
 }
 
 /// Draws the project's inputs (once, into `inputs/`), every intermediate stage of every supervisor (into
 /// `stages/`) and the final supervisors (at the top, apart from the rest).
-fn draw_synthesis(drawer: &mut Drawer<'_>, synthesis: &Synthesis) -> Result<()> {
+fn draw_synthesis(
+    drawer: &mut Drawer<'_>,
+    synthesis: &Synthesis,
+    reduction: Option<&Reduction>,
+) -> Result<()> {
     let project = &synthesis.normalised;
     for a in project.plants.iter().chain(&project.specs) {
         let stem = format!("inputs/{}", dot::file_stem(a.name()));
         drawer.draw(&stem, a, &HashMap::new(), ProbLabels::Stored)?;
     }
-    for s in synthesis
-        .supervisors
-        .iter()
-        .chain(&synthesis.monolithic_reference)
-    {
-        draw_stages(drawer, s)?;
+    for (i, s) in synthesis.supervisors.iter().enumerate() {
+        draw_stages(drawer, s, reduction.map(|r| &r.supervisors[i]))?;
+    }
+    if let Some(s) = &synthesis.monolithic_reference {
+        draw_stages(drawer, s, None)?;
+    }
+    for o in reduction.iter().flat_map(|r| &r.observers) {
+        let stem = format!("observer_{}", dot::file_stem(o.name()));
+        drawer.draw(&stem, o, &HashMap::new(), ProbLabels::Stored)?;
     }
     Ok(())
 }
 
-/// G, E, K (with the removed states marked), SupC before minimisation, and the final supervisor.
-fn draw_stages(drawer: &mut Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
+/// G, E, K (with the removed states marked), SupC before minimisation, with a reduction the minimised supervisor
+/// and its reduction (`_5_minimised`, `_6_reduced`), and the final supervisor (the one compiled).
+fn draw_stages(
+    drawer: &mut Drawer<'_>,
+    s: &SupervisorSynthesis,
+    reduction: Option<&SupervisorReduction>,
+) -> Result<()> {
     let stem = dot::file_stem(&s.name);
     let removed: HashMap<StateId, StateMark> = s
         .removed
@@ -543,7 +712,11 @@ fn draw_stages(drawer: &mut Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
         ("3_K", &s.target, &removed),
         ("4_supc", &s.unminimised, &none),
     ];
-    for (stage, automaton, marks) in stages {
+    let minimised = reduction.map(|_| ("5_minimised", &s.supervisor, &none));
+    let reduced = reduction
+        .and_then(|r| r.reduced.as_ref())
+        .map(|a| ("6_reduced", a, &none));
+    for (stage, automaton, marks) in stages.into_iter().chain(minimised).chain(reduced) {
         drawer.draw(
             &format!("stages/{stem}_{stage}"),
             automaton,
@@ -551,7 +724,8 @@ fn draw_stages(drawer: &mut Drawer<'_>, s: &SupervisorSynthesis) -> Result<()> {
             ProbLabels::Stored,
         )?;
     }
-    drawer.draw(&stem, &s.supervisor, &none, ProbLabels::Stored)?;
+    let last = reduction.map_or(&s.supervisor, SupervisorReduction::supervisor);
+    drawer.draw(&stem, last, &none, ProbLabels::Stored)?;
     Ok(())
 }
 

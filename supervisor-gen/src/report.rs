@@ -1,15 +1,20 @@
 //! `report.json`: the designer-facing summary of one synthesis run (docs/ptsct.md section 12, step 9).
 //!
 //! Per supervisor: size, events, every state SupC removed and why; the whole set's MemCons by the section 9 formula
-//! and the bytes actually written; the architecture checks; every validation warning. The report mirrors the
-//! pipeline's result in serialisable form and computes nothing new.
+//! and the bytes actually written; the architecture checks; every validation warning. With `synth --reduce`, each
+//! supervisor's size before and after reduction and the plant observers the reduced set needs. The report mirrors
+//! the pipeline's result in serialisable form and computes nothing new.
 
 use serde::Serialize;
 
 use crate::architecture::{Difference, LocalModularValidation, NonConflict};
 use crate::automaton::{Automaton, EventTable};
+use crate::compiled::mem_cons_of;
 use crate::diagnostics::Diagnostic;
 use crate::pipeline::{SupervisorStats, SupervisorSynthesis, Synthesis};
+use crate::reduce::{
+    ReduceLimits, Reduction, ReductionOutcome, SupervisorReduction, mem_cons_share,
+};
 use crate::supc::RemovalReason;
 
 /// The whole report.
@@ -32,6 +37,88 @@ pub struct Report {
     /// Outputs that were not written, and why (a supervisor set too large for the compiled format, a drawing
     /// too large to draw); empty when everything was written.
     pub skipped: Vec<SkippedOutput>,
+    /// The reduction of the set (`synth --reduce` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reduction: Option<ReductionReport>,
+}
+
+/// The reduction of the whole set (`synth --reduce`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ReductionReport {
+    /// MemCons of the unreduced set.
+    pub mem_cons_before: usize,
+    /// MemCons of the set written: supervisors and plant observers (what `mem_cons` describes; never more than
+    /// `mem_cons_before`).
+    pub mem_cons_after: usize,
+    /// Plant observers compiled after the supervisors (the plants the reduced supervisors rely on).
+    pub observers: Vec<ObserverReport>,
+    /// What was checked for every reduction before anything was written.
+    pub check: String,
+    /// Supervisors with more states are not reduced.
+    pub max_states: usize,
+    /// Pair checks one reduction may spend.
+    pub merge_budget: u64,
+    /// Supervisors not reduced, reductions cut short.
+    pub warnings: Vec<String>,
+}
+
+/// The XML files `synth --reduce` wrote besides the supervisors', relative to the output directory.
+#[derive(Debug, Clone, Copy)]
+pub struct ReductionFiles<'a> {
+    /// One per computed reduction (every supervisor not skipped), in order.
+    pub reduced: &'a [String],
+    /// One per plant observer, in order.
+    pub observers: &'a [String],
+}
+
+/// A plant observer of the reduced set.
+#[derive(Debug, Clone, Serialize)]
+pub struct ObserverReport {
+    /// The plant's name.
+    pub name: String,
+    /// The XML file written for it, relative to the output directory.
+    pub file: String,
+    /// States.
+    pub states: usize,
+    /// Transitions.
+    pub transitions: usize,
+    /// Its share of MemCons (arrays, membership row, current state).
+    pub mem_cons: usize,
+}
+
+/// One supervisor before and after reduction.
+#[derive(Debug, Clone, Serialize)]
+pub struct SupervisorReductionReport {
+    /// `reduced` (the reduction is written and compiled), `no gain` (the reduction is not smaller),
+    /// `observers cost more` (it is smaller, but the plant observers it needs are not) or `skipped` (too large);
+    /// in all but the first the minimised supervisor is written.
+    pub outcome: String,
+    /// Why the reduction was skipped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// `false` if the merge budget ran out (the reduction is correct but may not be minimal).
+    pub complete: bool,
+    /// The minimised supervisor.
+    pub before: ReductionSize,
+    /// The checked reduction (absent when skipped), whether it is used or not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub after: Option<ReductionSize>,
+    /// The reduction's XML file (`<supervisor>.reduced.xml`), written whether it is used or not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reduced_file: Option<String>,
+}
+
+/// Size of one supervisor for the reduction report.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ReductionSize {
+    /// States.
+    pub states: usize,
+    /// Transitions.
+    pub transitions: usize,
+    /// Controllable transitions.
+    pub controllable_transitions: usize,
+    /// The supervisor's share of MemCons: `(s + 3t) + 2(s + 2·t_c) + e + 2` bytes.
+    pub mem_cons: usize,
 }
 
 /// An output that was not written.
@@ -72,6 +159,10 @@ pub struct SupervisorReport {
     pub removed_unreachable: Vec<RemovedOther>,
     /// States of K removed as non-coaccessible (blocking).
     pub removed_non_coaccessible: Vec<RemovedOther>,
+    /// Before and after reduction (`synth --reduce` only; `states`, `transitions` and `controllable_transitions`
+    /// above then describe the supervisor written, the reduced one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reduction: Option<SupervisorReductionReport>,
 }
 
 /// Size counts of one automaton.
@@ -210,27 +301,12 @@ impl Report {
             .iter()
             .map(|s| &s.supervisor)
             .collect();
-        let mut mem = MemConsReport {
-            formula_bytes: synthesis.mem_cons,
-            s: 0,
-            t: 0,
-            t_c: 0,
-            e: events.len(),
-            n: finals.len(),
-            bytes_written,
-        };
-        for a in finals {
-            let stats = SupervisorStats::of(a, events);
-            mem.s += stats.states;
-            mem.t += stats.transitions;
-            mem.t_c += stats.controllable_transitions;
-        }
         Report {
             architecture: synthesis.architecture.to_string(),
             raw_weights: synthesis.options.raw_weights,
             thesis_literal_probabilities: synthesis.options.thesis_literal_probabilities,
             supervisors,
-            mem_cons: mem,
+            mem_cons: mem_cons_report(events, &finals, bytes_written),
             architecture_checks: ArchitectureChecks {
                 non_conflict: synthesis.non_conflict.as_ref().map(non_conflict),
                 local_modular_validation: synthesis
@@ -244,12 +320,115 @@ impl Report {
                 .cloned()
                 .collect(),
             skipped: Vec::new(),
+            reduction: None,
         }
+    }
+
+    /// Describes the reduced set of `synth --reduce`: each supervisor's size before and after, the XML `files`
+    /// of the reductions and observers, and `mem_cons` recomputed for the set written, whose compiled file has
+    /// `bytes_written` bytes.
+    pub fn with_reduction(
+        mut self,
+        reduction: &Reduction,
+        events: &EventTable,
+        files: ReductionFiles<'_>,
+        limits: ReduceLimits,
+        bytes_written: usize,
+    ) -> Self {
+        let mut reduced_files = files.reduced.iter();
+        for (entry, r) in self.supervisors.iter_mut().zip(&reduction.supervisors) {
+            let written = SupervisorStats::of(r.supervisor(), events);
+            entry.states = written.states;
+            entry.transitions = written.transitions;
+            entry.controllable_transitions = written.controllable_transitions;
+            let mut report = supervisor_reduction(r, events);
+            if r.reduced.is_some() {
+                report.reduced_file = reduced_files.next().cloned();
+            }
+            entry.reduction = Some(report);
+        }
+        let finals = reduction.final_automata();
+        let refs: Vec<&Automaton> = finals.iter().collect();
+        self.mem_cons = mem_cons_report(events, &refs, bytes_written);
+        self.reduction = Some(ReductionReport {
+            mem_cons_before: reduction.mem_cons_before,
+            mem_cons_after: reduction.mem_cons_after,
+            observers: reduction
+                .observers
+                .iter()
+                .zip(files.observers)
+                .map(|(o, file)| ObserverReport {
+                    name: o.name().to_owned(),
+                    file: file.clone(),
+                    states: o.state_count(),
+                    transitions: o.transition_count(),
+                    mem_cons: mem_cons_share(events, o),
+                })
+                .collect(),
+            check: "G ∥ S_red equals G ∥ S for every reduced supervisor: the same language and marked language, \
+                    the same P and T on every reachable transition, and timed transitions only where both \
+                    supervisors restarted their counters alike"
+                .to_owned(),
+            max_states: limits.max_states,
+            merge_budget: limits.merge_budget,
+            warnings: reduction.warnings(),
+        });
+        self
     }
 
     /// Pretty JSON (non-finite numbers become `null`).
     pub fn to_json(&self) -> serde_json::Result<String> {
         serde_json::to_string_pretty(self)
+    }
+}
+
+/// MemCons of `finals` by the formula, with its terms and the bytes written.
+fn mem_cons_report(
+    events: &EventTable,
+    finals: &[&Automaton],
+    bytes_written: usize,
+) -> MemConsReport {
+    let mut mem = MemConsReport {
+        formula_bytes: mem_cons_of(events, finals),
+        s: 0,
+        t: 0,
+        t_c: 0,
+        e: events.len(),
+        n: finals.len(),
+        bytes_written,
+    };
+    for a in finals {
+        let stats = SupervisorStats::of(a, events);
+        mem.s += stats.states;
+        mem.t += stats.transitions;
+        mem.t_c += stats.controllable_transitions;
+    }
+    mem
+}
+
+fn supervisor_reduction(r: &SupervisorReduction, events: &EventTable) -> SupervisorReductionReport {
+    let size = |a: &Automaton| {
+        let stats = SupervisorStats::of(a, events);
+        ReductionSize {
+            states: stats.states,
+            transitions: stats.transitions,
+            controllable_transitions: stats.controllable_transitions,
+            mem_cons: mem_cons_share(events, a),
+        }
+    };
+    let (outcome, reason) = match &r.outcome {
+        ReductionOutcome::Reduced => ("reduced", None),
+        ReductionOutcome::NoGain => ("no gain", None),
+        ReductionOutcome::ObserversCostMore => ("observers cost more", None),
+        ReductionOutcome::Skipped { reason } => ("skipped", Some(reason.clone())),
+    };
+    SupervisorReductionReport {
+        outcome: outcome.to_owned(),
+        reason,
+        complete: r.complete,
+        before: size(&r.original),
+        after: r.reduced.as_ref().map(size),
+        reduced_file: None,
     }
 }
 
@@ -300,6 +479,7 @@ fn supervisor_report(s: &SupervisorSynthesis, file: &str, events: &EventTable) -
         removed_bad,
         removed_unreachable,
         removed_non_coaccessible,
+        reduction: None,
     }
 }
 
