@@ -17,3 +17,4 @@ pub mod profile;
 pub mod profiles;
 pub mod resume;
 pub mod supervisors;
+pub mod zygote;

@@ -5,6 +5,7 @@
 //! ([`robot_agent::resume`]). SIGTERM or SIGINT asks the agent to leave the run: it stops at its next tick
 //! without answering it and exits 0 (the launcher restarts it only under the `always` policy).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,10 +18,13 @@ use robot_agent::controller::{self, Plan};
 use robot_agent::from_config;
 use robot_agent::params::Params;
 use robot_agent::resume::Resumer;
-use swarm_contract::config::Experiment;
+use robot_agent::zygote::{Forked, Zygote};
+use swarm_contract::config::{Controller, Experiment};
 use swarm_contract::limits::Limits;
 use swarm_contract::messages::ActuatorCommand;
-use swarm_contract::protocol::launcher_to_agent::AgentArgs;
+use swarm_contract::protocol::launcher_to_agent::{
+    AgentArgs, ZygoteArgs, ZygoteOrder, ZygoteReply,
+};
 use swarm_contract::protocol::resume::ResumePoint;
 use swarm_contract::transport::{AgentLink, RunSpec, TransportError};
 use tracing::{debug, info};
@@ -62,21 +66,50 @@ fn parse_param(s: &str) -> Result<(String, String), String> {
     }
 }
 
+/// Loads the experiment configuration, with the run's robot count when `swarm run --robots` changed it.
+fn load_experiment(path: &Path, robots: Option<u32>) -> Result<Experiment> {
+    let (experiment, warnings) = Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
+    let experiment = match robots {
+        Some(robots) => experiment
+            .with_robot_count(robots)
+            .map_err(|errors| anyhow!("{errors}"))?,
+        None => experiment,
+    };
+    for w in &warnings {
+        debug!("{w}");
+    }
+    Ok(experiment)
+}
+
+/// Plans and builds robot `robot`'s controller (`controller`) of `experiment`; `compiled` replaces the supervisors
+/// its parameters name.
+fn build_from_config(
+    experiment: &Experiment,
+    controller: &Controller,
+    seed: u64,
+    robot: u32,
+    compiled: Option<&Path>,
+) -> Result<(Plan, Control)> {
+    let (plan, control) = from_config::build(experiment, controller, seed, robot, compiled)?;
+    info!(
+        controller = controller.id.as_str(),
+        seed, "robot runs {plan}"
+    );
+    Ok((plan, control))
+}
+
+/// The run's limits: the configuration's `<system>` ones with the command line's `--limit` overrides.
+fn limits_of(experiment: &Experiment, overrides: &[String]) -> Result<Limits> {
+    let mut limits = experiment.framework.limits;
+    limits.apply(overrides)?;
+    Ok(limits)
+}
+
 /// Plans and builds the robot's controller from the configuration or from the manual flags; also the run's limits
 /// (the configuration's `<system>` ones with the command line's `--limit` overrides).
 fn build_control(args: &Args) -> Result<(Plan, Control, Limits)> {
     if let Some(path) = &args.agent.config {
-        let (experiment, warnings) =
-            Experiment::load(path).map_err(|errors| anyhow!("{errors}"))?;
-        let experiment = match args.agent.robots {
-            Some(robots) => experiment
-                .with_robot_count(robots)
-                .map_err(|errors| anyhow!("{errors}"))?,
-            None => experiment,
-        };
-        for w in &warnings {
-            debug!("{w}");
-        }
+        let experiment = load_experiment(path, args.agent.robots)?;
         let seed = match (args.agent.seed, experiment.framework.random_seed) {
             (Some(seed), _) | (None, Some(seed)) => seed,
             (None, None) => anyhow::bail!(
@@ -88,19 +121,14 @@ fn build_control(args: &Args) -> Result<(Plan, Control, Limits)> {
             Some(id) => from_config::controller_by_id(&experiment, id)?,
             None => from_config::controller_of(&experiment, args.agent.robot)?,
         };
-        let (plan, control) = from_config::build(
+        let (plan, control) = build_from_config(
             &experiment,
             controller,
             seed,
             args.agent.robot,
             args.agent.compiled_supervisors.as_deref(),
         )?;
-        info!(
-            controller = controller.id.as_str(),
-            seed, "robot runs {plan}"
-        );
-        let mut limits = experiment.framework.limits;
-        limits.apply(&args.agent.limits)?;
+        let limits = limits_of(&experiment, &args.agent.limits)?;
         return Ok((plan, control, limits));
     }
     let mut pairs = args.params.clone();
@@ -156,28 +184,43 @@ fn limit_reached(error: &TransportError) -> bool {
     }
 }
 
+/// Which robot of which run an agent serves, and from where it resumes.
+struct Seat<'a> {
+    run: &'a RunSpec,
+    robot: u32,
+    slot: u32,
+    resume: Option<&'a Path>,
+}
+
 /// Answers every tick of the run until the world ends it.
-fn serve(
-    args: &Args,
-    root: &std::path::Path,
-    control: &mut Control,
-    limits: &Limits,
-) -> Result<()> {
-    let point = match &args.agent.resume {
+fn serve(seat: &Seat<'_>, control: &mut Control, limits: &Limits) -> Result<()> {
+    let point = match seat.resume {
         Some(path) => Some(ResumePoint::read(path)?),
         None => None,
     };
     let mut resumer = Resumer::new(point);
-    let run = RunSpec::new(&args.agent.run, root)?;
-    let slot = args.agent.slot.unwrap_or(args.agent.robot);
-    let mut link = join(&run, slot, limits)?;
+    let joining = Instant::now();
+    let mut link = join(seat.run, seat.slot, limits)?;
     info!(
-        run = args.agent.run.as_str(),
-        robot = args.agent.robot,
-        slot,
+        run = seat.run.name(),
+        robot = seat.robot,
+        slot = seat.slot,
+        took = ?joining.elapsed(),
         "joined the run"
     );
-    tick_loop(&mut link, control, &mut resumer, args.agent.robot)
+    match tick_loop(&mut link, control, &mut resumer, seat.robot)? {
+        Ending::RunEnded => link.release_ended_run(),
+        Ending::Leaving => drop(link),
+    }
+    Ok(())
+}
+
+/// Why an agent's tick loop ended.
+enum Ending {
+    /// The world ended the run.
+    RunEnded,
+    /// The agent was asked to leave a run that goes on.
+    Leaving,
 }
 
 /// The agent's tick loop: step the controller on each tick's frame and answer, until the world ends the run or
@@ -189,14 +232,14 @@ fn tick_loop(
     control: &mut Control,
     resumer: &mut Resumer,
     robot: u32,
-) -> Result<()> {
+) -> Result<Ending> {
     // One command lives across ticks: wheel speeds and LEDs persist until an action changes them.
     let mut command = ActuatorCommand::idle(robot, 0);
     link.set_sender(robot);
     while let Some(mut tick) = link.next_tick().context("waiting for a tick")? {
         if STOP_REQUESTED.load(Ordering::Relaxed) {
             info!(robot, "asked to stop: leaving the run");
-            return Ok(());
+            return Ok(Ending::Leaving);
         }
         let (frame, inbox, outbox) = tick.parts();
         if resumer.before_step(control, frame)? {
@@ -207,7 +250,7 @@ fn tick_loop(
         tick.answer(&mut command);
     }
     info!(robot, "the world ended the run");
-    Ok(())
+    Ok(Ending::RunEnded)
 }
 
 /// Set by SIGTERM and SIGINT.
@@ -248,20 +291,148 @@ fn run(args: &Args) -> Result<()> {
         return Ok(());
     };
     install_stop_handler()?;
-    serve(args, root, &mut control, &limits)
+    let run = RunSpec::new(&args.agent.run, root)?;
+    let seat = Seat {
+        run: &run,
+        robot: args.agent.robot,
+        slot: args.agent.slot.unwrap_or(args.agent.robot),
+        resume: args.agent.resume.as_deref(),
+    };
+    serve(&seat, &mut control, &limits)
         .with_context(|| format!("robot {} in run {}", args.agent.robot, args.agent.run))
 }
 
-fn main() -> ExitCode {
-    swarm_contract::logging::init("info,supervisor_gen=warn");
-    match run(&Args::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+/// `robot-agent zygote`: starts many agents of one run by forking this process once it has loaded the
+/// configuration (see `robot_agent::zygote`). The launcher and `swarm host` start their robots this way.
+#[derive(Debug, Parser)]
+#[command(name = "robot-agent zygote", version)]
+struct ZygoteCli {
+    #[command(flatten)]
+    args: ZygoteArgs,
+}
+
+/// Reads the zygote's orders (one robot per line) up to an empty line or the end of its standard input: all of
+/// them before the first fork, so the launcher never waits on a full pipe while the zygote writes its replies.
+fn read_orders() -> Result<Vec<ZygoteOrder>> {
+    let mut orders = Vec::new();
+    for (number, line) in std::io::stdin().lines().enumerate() {
+        let line = line.context("reading the zygote's orders")?;
+        if line.is_empty() {
+            break;
+        }
+        let order = line
+            .parse()
+            .map_err(|e| anyhow!("standard input, line {}: {e}", number + 1))?;
+        orders.push(order);
+    }
+    Ok(orders)
+}
+
+/// The zygote: loads the experiment once, then forks one agent per order and answers with its process id.
+fn run_zygote(args: &ZygoteArgs) -> Result<()> {
+    let experiment = load_experiment(&args.config, args.robots)?;
+    let limits = limits_of(&experiment, &args.limits)?;
+    let run = RunSpec::new(&args.run.run, &args.run.iox_root)?;
+    let orders = read_orders()?;
+    // Each robot's controller, found once for all (a robot's own lookup walks every participant).
+    let participants = experiment.participants();
+    let controller_of = |robot: u32| {
+        let participant = participants.get(robot as usize)?;
+        experiment.controller(participant.controller)
+    };
+    install_stop_handler()?;
+    let zygote = Zygote::prepare().context("preparing to fork agents")?;
+    let mut out = std::io::stdout();
+    for order in orders {
+        let reply = match zygote.fork_agent() {
+            Ok(Forked::Agent) => {
+                let seat = Seat {
+                    run: &run,
+                    robot: order.robot,
+                    slot: order.slot,
+                    resume: None,
+                };
+                let controller = controller_of(order.robot);
+                let code =
+                    agent_from_zygote(&zygote, &experiment, controller, args, &limits, &seat);
+                std::process::exit(code);
+            }
+            Ok(Forked::Zygote(pid)) => ZygoteReply::Started {
+                robot: order.robot,
+                pid,
+            },
+            Err(e) => ZygoteReply::Failed {
+                robot: order.robot,
+                reason: format!("cannot fork: {e}"),
+            },
+        };
+        // Flushed before the next fork, so no agent inherits an unwritten reply.
+        writeln!(out, "{reply}")
+            .and_then(|()| out.flush())
+            .context("answering the launcher")?;
+    }
+    Ok(())
+}
+
+/// The life of one agent forked by the zygote, as `robot-agent --run ... --robot ...` would live it; its exit code.
+fn agent_from_zygote(
+    zygote: &Zygote,
+    experiment: &Experiment,
+    controller: Option<&Controller>,
+    args: &ZygoteArgs,
+    limits: &Limits,
+    seat: &Seat<'_>,
+) -> i32 {
+    let log = swarm_contract::run_dir::agent_log_in(&args.logs, seat.robot);
+    if let Err(e) = zygote.become_agent(&log) {
+        eprintln!("error: robot {}: cannot become an agent: {e}", seat.robot);
+        return 1;
+    }
+    // Without the zygote's lookup, the robot's own one says what is wrong.
+    let served = controller
+        .map_or_else(|| from_config::controller_of(experiment, seat.robot), Ok)
+        .map_err(anyhow::Error::from)
+        .and_then(|controller| {
+            let compiled = args.compiled_for(&controller.id);
+            build_from_config(
+                experiment,
+                controller,
+                args.seed,
+                seat.robot,
+                compiled.as_deref(),
+            )
+        })
+        .with_context(|| format!("robot {}: cannot start its controller", seat.robot))
+        .and_then(|(_, mut control)| {
+            zygote
+                .wait_for_the_run()
+                .context("waiting for the run's shared memory")?;
+            serve(seat, &mut control, limits)
+                .with_context(|| format!("robot {} in run {}", seat.robot, seat.run.name()))
+        });
+    exit_code(served)
+}
+
+/// Reports `result` the way every agent does; its exit code.
+fn exit_code(result: Result<()>) -> i32 {
+    match result {
+        Ok(()) => 0,
         Err(err) => {
             eprintln!(
                 "error: {}",
                 swarm_contract::logging::error_chain(err.as_ref())
             );
-            ExitCode::FAILURE
+            1
         }
     }
+}
+
+fn main() -> ExitCode {
+    swarm_contract::logging::init("info,supervisor_gen=warn");
+    let result = if std::env::args_os().nth(1).is_some_and(|a| a == "zygote") {
+        run_zygote(&ZygoteCli::parse_from(std::env::args_os().skip(1)).args)
+    } else {
+        run(&Args::parse())
+    };
+    ExitCode::from(exit_code(result) as u8)
 }

@@ -98,7 +98,10 @@ fn forty_robot_run_completes_with_one_process_per_robot() {
     let compiled = out.path().join("supervisors").join("fdc.ptsct");
     assert!(compiled.is_file(), "the launcher compiles the models once");
     let logs = std::fs::read_dir(out.path().join("logs")).expect("agent logs");
-    for log in logs.flatten() {
+    let agent_logs = logs
+        .flatten()
+        .filter(|log| log.file_name().to_string_lossy().starts_with("robot-"));
+    for log in agent_logs {
         let text = std::fs::read_to_string(log.path()).expect("agent log");
         assert!(
             text.contains("fdc.ptsct"),

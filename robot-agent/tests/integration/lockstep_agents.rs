@@ -1,10 +1,13 @@
 //! Real robot-agent processes in a lockstep run over the runtime's iceoryx2 transport, driven by an in-test world.
 
+use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 use swarm_contract::messages::SensorFrame;
+use swarm_contract::process::children::AgentProcess;
+use swarm_contract::protocol::launcher_to_agent::ZygoteReply;
 use swarm_contract::transport::{LinkConfig, RunSpec, WorldLink};
 
 const AGENT: &str = env!("CARGO_BIN_EXE_robot-agent");
@@ -105,4 +108,117 @@ fn native_and_supervised_agents_answer_every_tick_and_exit_when_the_run_ends() {
     run.children.clear();
     run.spec.cleanup().unwrap();
     assert_eq!(run.spec.leftovers(), Vec::<std::path::PathBuf>::new());
+}
+
+/// Starts `robot-agent zygote` for robots 0..3 of the thesis example (cut to 3 robots), logging into `logs`.
+fn start_zygote(spec: &RunSpec, logs: &Path) -> Child {
+    Command::new(AGENT)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .env("RUST_LOG", "info")
+        .args(["zygote", "--run", spec.name(), "--iox-root"])
+        .arg(spec.root_dir())
+        .args(["--seed", "124", "--robots", "3", "--logs"])
+        .arg(logs)
+        .args([
+            "--config",
+            "configs/obstacle_avoidance/thesis_example.argos",
+        ])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+#[test]
+fn zygote_agents_are_the_callers_children_and_join_only_when_let_in() {
+    let logs = tempfile::tempdir().unwrap();
+    let run = Run {
+        spec: RunSpec::unique(),
+        children: Vec::new(),
+    };
+    let mut zygote = start_zygote(&run.spec, logs.path());
+    let mut gate = zygote.stdin.take().unwrap();
+    gate.write_all(b"0 0\n1 1\n2 2\n\n").unwrap();
+    let replies: Vec<ZygoteReply> = BufReader::new(zygote.stdout.take().unwrap())
+        .lines()
+        .map(|line| line.unwrap().parse().unwrap())
+        .collect();
+    assert!(zygote.wait().unwrap().success());
+    let mut agents = Agents(Vec::new());
+    for (robot, reply) in (0..).zip(&replies) {
+        let ZygoteReply::Started { robot: r, pid } = reply else {
+            panic!("robot {robot} was not started: {reply}");
+        };
+        assert_eq!(*r, robot);
+        // Forked with CLONE_PARENT: this process, not the zygote, is their parent and reaps them.
+        agents.0.push(AgentProcess::adopt(*pid).unwrap());
+    }
+    assert_eq!(agents.0.len(), 3);
+    // The run's shared memory is created only now, as the world of a launcher does while the agents wait.
+    let mut world = WorldLink::create(&run.spec, LinkConfig::new(3)).unwrap();
+    for agent in &agents.0 {
+        assert_eq!(
+            agent.try_wait().unwrap(),
+            None,
+            "an agent ended before it was let in"
+        );
+    }
+    drop(gate);
+    world.wait_for_agents(JOIN_TIMEOUT).unwrap();
+    for tick in 1..=5 {
+        let outcome = world.tick_with(sense).unwrap();
+        assert_eq!(outcome.answered, 3, "tick {tick}: {outcome:?}");
+    }
+    drop(world);
+    for agent in agents.0.drain(..) {
+        assert!(agent.wait().unwrap().success());
+    }
+    for robot in 0..3 {
+        let log = std::fs::read_to_string(logs.path().join(format!("robot-{robot}.log"))).unwrap();
+        assert!(
+            log.contains("joined the run"),
+            "robot {robot}'s log:\n{log}"
+        );
+        assert!(
+            log.contains("the world ended the run"),
+            "robot {robot}'s log:\n{log}"
+        );
+    }
+    run.spec.cleanup().unwrap();
+    assert_eq!(run.spec.leftovers(), Vec::<std::path::PathBuf>::new());
+}
+
+#[test]
+fn a_zygote_refuses_a_malformed_order_before_forking_anything() {
+    let logs = tempfile::tempdir().unwrap();
+    let spec = RunSpec::unique();
+    let mut zygote = start_zygote(&spec, logs.path());
+    zygote
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"0 0\nthree\n\n")
+        .unwrap();
+    let output = zygote.wait_with_output().unwrap();
+    assert!(!output.status.success());
+    assert!(output.stdout.is_empty(), "{:?}", output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("standard input, line 2: `three` is not `<robot> <slot>`"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(logs.path()).unwrap().count(), 0);
+}
+
+/// Agents forked by a zygote; killed and reaped if a test fails before it reaps them itself.
+struct Agents(Vec<AgentProcess>);
+
+impl Drop for Agents {
+    fn drop(&mut self) {
+        for agent in &self.0 {
+            agent.signal(nix::sys::signal::Signal::SIGKILL);
+            let _ = agent.wait();
+        }
+    }
 }

@@ -212,7 +212,12 @@ pub fn logs_dir(run_dir: &Path) -> PathBuf {
 
 /// The log file of one robot's agent.
 pub fn agent_log(run_dir: &Path, robot: u32) -> PathBuf {
-    logs_dir(run_dir).join(format!("robot-{robot}.log"))
+    agent_log_in(&logs_dir(run_dir), robot)
+}
+
+/// The log file of one robot's agent in the logs folder `logs` (a run's `logs/`, or a host's own folder).
+pub fn agent_log_in(logs: &Path, robot: u32) -> PathBuf {
+    logs.join(format!("robot-{robot}.log"))
 }
 
 /// The snapshot image of `tick`.

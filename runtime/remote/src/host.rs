@@ -36,7 +36,7 @@ use super::{RemoteError, keys};
 use swarm_contract::mail::Mailbox;
 use swarm_contract::messages::SupervisorSnapshot;
 use swarm_contract::process::binaries::Binaries;
-use swarm_contract::process::children::{self, Children};
+use swarm_contract::process::children::{AgentProcess, Children};
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs, start_agent};
 use swarm_contract::protocol::resume::{ResumeError, ResumePoint};
 use swarm_contract::run_dir;
@@ -596,7 +596,7 @@ impl Share {
         &self,
         slot: usize,
         resume: Option<PathBuf>,
-    ) -> Result<std::process::Child, RemoteError> {
+    ) -> Result<AgentProcess, RemoteError> {
         let (robot, controller) = &self.assignment.robots[slot];
         let run = RunArgs {
             run: self.spec.name().to_owned(),
@@ -620,15 +620,17 @@ impl Share {
         args.robots = self.assignment.robots_override;
         args.limits = self.assignment.limits.clone();
         args.resume = resume;
-        let log_path = log_file(&self.logs, *robot);
+        let log_path = run_dir::agent_log_in(&self.logs, *robot);
         let log = std::fs::File::create(&log_path).map_err(|source| RemoteError::Io {
             what: format!("creating {}", log_path.display()),
             source,
         })?;
-        start_agent(&self.agent, &args, log).map_err(|source| RemoteError::Io {
-            what: format!("starting {}", self.agent.display()),
-            source,
-        })
+        start_agent(&self.agent, &args, log)
+            .map(AgentProcess::from)
+            .map_err(|source| RemoteError::Io {
+                what: format!("starting {}", self.agent.display()),
+                source,
+            })
     }
 
     /// Carries out a fault order for robot `robot` of the share; the reason when it cannot be.
@@ -649,12 +651,12 @@ impl Share {
             }
             OrderAction::Freeze => {
                 let agent = agent.ok_or_else(|| format!("robot {robot} has no running agent"))?;
-                children::signal(agent, nix::sys::signal::Signal::SIGSTOP);
+                agent.signal(nix::sys::signal::Signal::SIGSTOP);
                 link.mark_dead(slot_id).map_err(|e| e.to_string())
             }
             OrderAction::Thaw => {
                 let agent = agent.ok_or_else(|| format!("robot {robot}'s agent is gone"))?;
-                children::signal(agent, nix::sys::signal::Signal::SIGCONT);
+                agent.signal(nix::sys::signal::Signal::SIGCONT);
                 revive(link, slot_id, robot)
             }
             OrderAction::Skip => link.mark_dead(slot_id).map_err(|e| e.to_string()),
@@ -714,7 +716,7 @@ impl Share {
             .into_iter()
             .find(|(slot, _)| slots(*slot as usize))?;
         let robot = self.robots.get(slot as usize).copied().unwrap_or(slot);
-        let log = run_dir::tail(&log_file(&self.logs, robot), LOG_LINES_QUOTED);
+        let log = run_dir::tail(&run_dir::agent_log_in(&self.logs, robot), LOG_LINES_QUOTED);
         Some(format!("robot {robot} failed to start ({status}):\n{log}"))
     }
 
@@ -905,10 +907,6 @@ fn revive(link: &WorldLink, slot: u32, robot: u32) -> Result<(), String> {
     } else {
         Err(format!("robot {robot}'s agent is no longer connected"))
     }
-}
-
-fn log_file(logs: &Path, robot: u32) -> PathBuf {
-    logs.join(format!("robot-{robot}.log"))
 }
 
 /// Writes the run's compiled supervisor sets where this host's agents load them (`<logs>/supervisors/`, as in a

@@ -149,9 +149,7 @@ impl FaultDriver {
     ) -> anyhow::Result<FaultDriver> {
         let robots = link.robots();
         if let Link::Local(local) = link {
-            for robot in 0..robots as u32 {
-                local.mark_dead(robot)?;
-            }
+            local.start_without_agents();
         }
         let bodies = world.robot_count();
         let mut plan = FaultPlan::new(schedule, world.arena.ticks_per_second, seed);

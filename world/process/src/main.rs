@@ -153,7 +153,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
     faults.wait_for_agents(&mut link, &mut world, &mut recorder, &commands)?;
-    let cpu = TickingCpu::start(&link);
+    let (mut cpu, mut cpu_marked) = (None, false);
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -204,6 +204,10 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 dead: outcome.dead,
             });
         }
+        if !cpu_marked {
+            cpu_marked = true;
+            cpu = TickingCpu::start(&link, robot_steps);
+        }
         pacer.end_of_tick(outcome.tick);
         if let Some(reason) = budget.exceeded() {
             tracing::error!(tick = outcome.tick, "stopping the run: {reason}");
@@ -212,6 +216,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         }
     }
     let ticking = started.elapsed().as_secs_f64();
+    tracing::debug!("last tick done");
     let cpu = cpu.map(|cpu| cpu.summary(&link, robot_steps));
     let ticks = link.tick();
     let mut extra = serde_json::json!({
@@ -239,6 +244,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         }
     }
     recorder.finish(&world, extra)?;
+    link.end();
     report(WorldReport::Finished { ticks });
     Ok(())
 }

@@ -62,6 +62,15 @@ pub enum Link {
 }
 
 impl Link {
+    /// Ends the run for the agents as the world exits: a local run's shared memory is left to the launcher,
+    /// which removes it whole (see `WorldLink::end_run`); hosts are told the run is over.
+    pub fn end(self) {
+        match self {
+            Link::Local(link) => link.end_run(),
+            Link::Remote(hosts) => drop(hosts),
+        }
+    }
+
     /// The link of a run whose robots are placed on hosts: opens the world's zenoh session.
     pub fn remote(
         mut plan: HostsPlan,

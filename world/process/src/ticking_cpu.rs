@@ -10,17 +10,20 @@ use swarm_contract::cpu::CpuMark;
 
 use crate::remote::Link;
 
-/// The marks taken at the first tick.
+/// The marks taken after the first tick (reading every agent's accounts takes tens of milliseconds at 1,000
+/// robots, which the first tick should not wait for).
 pub struct TickingCpu {
     agents: Vec<u32>,
     agents_mark: CpuMark,
     world_mark: CpuMark,
     first_tick: u64,
+    first_steps: u64,
 }
 
 impl TickingCpu {
-    /// Marks the CPU used so far by the agents of a local link and by this process; `None` on hosts.
-    pub fn start(link: &Link) -> Option<TickingCpu> {
+    /// Marks the CPU used so far by the agents of a local link and by this process, after `robot_steps`
+    /// answered steps; `None` on hosts.
+    pub fn start(link: &Link, robot_steps: u64) -> Option<TickingCpu> {
         let Link::Local(local) = link else {
             return None;
         };
@@ -30,12 +33,14 @@ impl TickingCpu {
             world_mark: CpuMark::take_of([std::process::id()]),
             agents,
             first_tick: link.tick(),
+            first_steps: robot_steps,
         })
     }
 
-    /// The figures for summary.json after `robot_steps` answered steps: `cpu_world_us_per_tick` and, when no
-    /// agent was replaced, `cpu_agents_us_per_robot_step`.
+    /// The figures for summary.json after `robot_steps` answered steps in all: `cpu_world_us_per_tick` and,
+    /// when no agent was replaced, `cpu_agents_us_per_robot_step`, both since the mark.
     pub fn summary(&self, link: &Link, robot_steps: u64) -> serde_json::Value {
+        let robot_steps = robot_steps.saturating_sub(self.first_steps);
         let ticks = link.tick().saturating_sub(self.first_tick) as f64;
         let world = self.world_mark.per_step_of([std::process::id()], ticks);
         let same_agents = match link {

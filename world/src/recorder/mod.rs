@@ -209,10 +209,13 @@ impl Recorder {
     /// The final snapshot is drawn here rather than in the last tick: drawing it there counted as tick time and
     /// made the last tick of a 2,000-robot real-time run 50 ms late.
     pub fn finish(self, world: &World, extra: serde_json::Value) -> Result<PathBuf, WorldError> {
+        let started = std::time::Instant::now();
         if !self.snapshot_ticks.contains(&world.tick()) {
             self.snapshot(world)?;
         }
+        let drawn = started.elapsed();
         self.files.finish()?;
+        tracing::debug!(snapshot = ?drawn, files = ?(started.elapsed() - drawn), "records finished");
         let movable: Vec<serde_json::Value> = world
             .arena
             .obstacles

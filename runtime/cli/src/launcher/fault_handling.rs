@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use nix::sys::signal::Signal;
 
-use super::agents::AgentState;
+use super::agents::{AgentState, present_robots};
 use super::control::{CtlCommand, CtlRequest};
 use super::fault_log::{FaultRecord, RestartRecord};
 use super::restart::{Ending, Restart};
@@ -26,23 +26,19 @@ use swarm_contract::protocol::resume::ResumePoint;
 use swarm_contract::protocol::world_to_launcher::DownCause;
 
 impl Supervision {
-    /// Starts every robot's agent; robots the schedule kills at start-up are killed right after their start
-    /// (before they can join), and the world hears of their death at once.
+    /// Starts every robot's agent that the zygote did not fork (see
+    /// [`AgentSpawner::fork_held`](super::agents::AgentSpawner::fork_held)); robots the schedule kills at
+    /// start-up are killed right after their start (before they can join), and the world hears of their death
+    /// at once.
     pub(super) fn start_agents(&mut self, startup: &[FaultAction]) -> Result<(), LaunchError> {
-        self.children.agents.reserve(self.robots.len());
-        for robot in 0..self.robots.len() as u32 {
-            // A robot that joins later gets its agent when it joins.
-            if self.robots[robot as usize].state == AgentState::Absent {
-                self.children.agents.push(None);
-                continue;
+        self.children.agents.resize_with(self.robots.len(), || None);
+        self.spawner
+            .spawn_missing(&present_robots(&self.robots), &mut self.children.agents)?;
+        for (entry, agent) in self.robots.iter_mut().zip(&self.children.agents) {
+            if let Some(agent) = agent {
+                entry.pid = agent.id();
+                entry.first_pid = agent.id();
             }
-            let child = self
-                .spawner
-                .spawn(robot, &self.robots[robot as usize].controller, None)?;
-            let entry = &mut self.robots[robot as usize];
-            entry.pid = child.id();
-            entry.first_pid = child.id();
-            self.children.agents.push(Some(child));
         }
         for action in startup {
             if let (FaultKind::Kill, Some(robot)) = (action.kind, action.robot) {
@@ -400,7 +396,7 @@ impl Supervision {
         if self.on_hosts() {
             self.robots[robot as usize].state = state;
         } else if let Some(Some(child)) = self.children.agents.get(robot as usize) {
-            children::signal(child, signal);
+            child.signal(signal);
             self.robots[robot as usize].state = state;
         }
     }

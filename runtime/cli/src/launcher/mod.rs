@@ -38,7 +38,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use indicatif::{ProgressBar, ProgressStyle};
 use nix::sys::signal::Signal;
 
-use agents::{AgentSpawner, RobotEntry};
+use agents::{AgentSpawner, HeldAgents, RobotEntry, present_robots};
 use control::{ControlServer, CtlRequest};
 use fault_log::FaultRecord;
 use plain_progress::PlainProgress;
@@ -60,6 +60,9 @@ use swarm_remote::plan::{Authentication, HostsArgs, HostsError, HostsPlan};
 
 /// How often the supervision loop looks at its children when the world is quiet.
 const SUPERVISION_PERIOD: Duration = Duration::from_millis(20);
+/// How often the launcher looks for agents that exited once the run has ended: they exit within milliseconds of
+/// the world's end, and the run is not over before the last of them.
+const EXIT_POLL_PERIOD: Duration = Duration::from_millis(1);
 /// Lines of an agent's log quoted when it fails to start.
 const LOG_LINES_QUOTED: usize = 8;
 
@@ -334,6 +337,27 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         &out_dir,
     )?;
 
+    let spawner = AgentSpawner {
+        program: binaries.agent.clone(),
+        run: run_args.clone(),
+        config: config.clone(),
+        seed,
+        robots: options.robots,
+        out_dir: out_dir.clone(),
+        compiled,
+        limits: options.limits.clone(),
+    };
+    let robot_entries: Vec<RobotEntry> = roster
+        .iter()
+        .map(|r| {
+            RobotEntry::new(
+                r.arrival,
+                r.controller.to_owned(),
+                RestartTracker::new(schedule.restart_rule(r.index, r.controller).cloned()),
+            )
+        })
+        .collect();
+
     let started = Instant::now();
     let mut children = Children::default();
     let world_args = WorldArgs {
@@ -359,6 +383,25 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     let world_stdin = world.stdin.take();
     let reports = follow_reports(world.stdout.take());
     children.world = Some(world);
+    // The agents are forked while the world creates the run's shared memory, and let in once it is ready.
+    // With hosts, each host daemon starts its own robots' agents; the world waits for them.
+    // Robots the schedule kills at start-up are started on their own and killed before they can join.
+    let killed_at_start: Vec<u32> = startup
+        .iter()
+        .filter(|action| action.kind == FaultKind::Kill)
+        .filter_map(|action| action.robot)
+        .collect();
+    let mut held = if placement.is_none() {
+        let mut present = present_robots(&robot_entries);
+        present.retain(|(robot, _)| !killed_at_start.contains(robot));
+        spawner.fork_held(&present)
+    } else {
+        HeldAgents::default()
+    };
+    children.agents = (0..robots).map(|_| None).collect();
+    for (robot, agent) in held.agents.drain(..) {
+        children.agents[robot as usize] = Some(agent);
+    }
 
     wait_ready(
         &mut children,
@@ -366,7 +409,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         robots,
         limits.world_ready_timeout(),
     )?;
-    // With hosts, each host daemon starts its own robots' agents; the world waits for them.
+    held.release();
     if let Some(placement) = &placement {
         for share in placement {
             tracing::info!(host = share.name, robots = share.robots.len(), "placed");
@@ -382,16 +425,6 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             None
         }
     };
-    let spawner = AgentSpawner {
-        program: binaries.agent.clone(),
-        run: run_args.clone(),
-        config: config.clone(),
-        seed,
-        robots: options.robots,
-        out_dir: out_dir.clone(),
-        compiled,
-        limits: options.limits.clone(),
-    };
     let progress = progress_bar(options.progress, ticks, robots);
     let mut supervision = Supervision {
         children,
@@ -405,16 +438,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         last_tick: 0,
         deaths: Vec::new(),
         interrupted: false,
-        robots: roster
-            .iter()
-            .map(|r| {
-                RobotEntry::new(
-                    r.arrival,
-                    r.controller.to_owned(),
-                    RestartTracker::new(schedule.restart_rule(r.index, r.controller).cloned()),
-                )
-            })
-            .collect(),
+        robots: robot_entries,
         spawner,
         ticks_per_second,
         faults: Vec::new(),
@@ -760,8 +784,10 @@ impl Supervision {
                     ));
                 }
                 Ok(WorldReport::Finished { ticks }) => {
+                    tracing::debug!(ticks, "the world finished its records");
                     self.last_tick = ticks;
                     self.wait_world()?;
+                    tracing::debug!("the world exited");
                     return Ok(());
                 }
                 Ok(WorldReport::Fault { tick, kind, robot }) => {
@@ -871,10 +897,11 @@ impl Supervision {
         self.thaw_all();
         let stragglers = self
             .children
-            .end_agents(self.agent_exit_grace, SUPERVISION_PERIOD);
+            .end_agents(self.agent_exit_grace, EXIT_POLL_PERIOD);
         if stragglers > 0 {
             tracing::warn!(stragglers, "agents did not exit after the run; killed them");
         }
+        tracing::debug!("every agent exited");
     }
 
     /// What the run did, for `summary.json` and the caller.

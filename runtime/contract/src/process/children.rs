@@ -5,7 +5,7 @@
 //! when the launcher dies (`PR_SET_PDEATHSIG`), so no robot outlives a killed launcher. Dropping [`Children`]
 //! kills and reaps every child that is still running.
 
-use std::os::unix::process::CommandExt;
+use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::process::{Child, Command, ExitStatus};
 use std::time::{Duration, Instant};
 
@@ -42,6 +42,73 @@ pub fn signal(child: &Child, signal: Signal) {
     }
 }
 
+/// A robot's agent process, a child of this process: started with [`spawn`] or forked by the agent zygote
+/// (`robot-agent zygote`), which makes its children this process's children. Known by process id only, so that
+/// both kinds are signalled and reaped the same way.
+#[derive(Debug)]
+pub struct AgentProcess {
+    pid: Pid,
+}
+
+impl AgentProcess {
+    /// The child with process id `pid`, which must be a child of this process that nobody else reaps.
+    pub fn adopt(pid: u32) -> std::io::Result<AgentProcess> {
+        let raw = i32::try_from(pid)
+            .ok()
+            .filter(|&p| p > 0)
+            .ok_or_else(|| std::io::Error::other(format!("{pid} is not a process id")))?;
+        Ok(AgentProcess {
+            pid: Pid::from_raw(raw),
+        })
+    }
+
+    /// Its process id.
+    pub fn id(&self) -> u32 {
+        self.pid.as_raw() as u32
+    }
+
+    /// Sends `signal`; a process that already exited is not an error.
+    pub fn signal(&self, signal: Signal) {
+        let _ = kill(self.pid, signal);
+    }
+
+    /// Its exit status if it has exited (reaping it), `None` while it runs.
+    pub fn try_wait(&self) -> std::io::Result<Option<ExitStatus>> {
+        self.wait_with(libc::WNOHANG)
+    }
+
+    /// Waits for it to exit and reaps it.
+    pub fn wait(&self) -> std::io::Result<ExitStatus> {
+        loop {
+            match self.wait_with(0) {
+                Ok(Some(status)) => return Ok(status),
+                Ok(None) => continue,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    fn wait_with(&self, flags: libc::c_int) -> std::io::Result<Option<ExitStatus>> {
+        let mut status: libc::c_int = 0;
+        // SAFETY: waitpid only writes the status word it is given.
+        match unsafe { libc::waitpid(self.pid.as_raw(), &mut status, flags) } {
+            0 => Ok(None),
+            -1 => Err(std::io::Error::last_os_error()),
+            _ => Ok(Some(ExitStatus::from_raw(status))),
+        }
+    }
+}
+
+impl From<Child> for AgentProcess {
+    /// Takes over a child started with [`spawn`]; its standard streams, if any were piped, are closed.
+    fn from(child: Child) -> AgentProcess {
+        AgentProcess {
+            pid: Pid::from_raw(child.id() as i32),
+        }
+    }
+}
+
 /// Whether some child of this process has exited and waits to be reaped: one system call, which reaps nothing.
 fn a_child_exited() -> bool {
     let flags = WaitPidFlag::WEXITED | WaitPidFlag::WNOHANG | WaitPidFlag::WNOWAIT;
@@ -57,7 +124,7 @@ pub struct Children {
     /// The world process, while it runs.
     pub world: Option<Child>,
     /// Agent processes by robot index; `None` once reaped.
-    pub agents: Vec<Option<Child>>,
+    pub agents: Vec<Option<AgentProcess>>,
 }
 
 impl Children {
@@ -81,8 +148,8 @@ impl Children {
 
     /// SIGKILLs `robot`'s agent and reaps it; its exit status, or `None` if it had no running agent.
     pub fn kill_agent(&mut self, robot: u32) -> Option<ExitStatus> {
-        let mut child = self.agents.get_mut(robot as usize)?.take()?;
-        signal(&child, Signal::SIGKILL);
+        let child = self.agents.get_mut(robot as usize)?.take()?;
+        child.signal(Signal::SIGKILL);
         child.wait().ok()
     }
 
@@ -107,21 +174,17 @@ impl Children {
 
     /// Kills and reaps every child still running.
     pub fn kill_all(&mut self) {
-        for child in self
-            .agents
-            .iter_mut()
-            .flatten()
-            .chain(self.world.iter_mut())
-        {
-            signal(child, Signal::SIGKILL);
+        for agent in self.agents.iter().flatten() {
+            agent.signal(Signal::SIGKILL);
         }
-        for child in self
-            .agents
-            .iter_mut()
-            .flatten()
-            .chain(self.world.iter_mut())
-        {
-            let _ = child.wait();
+        if let Some(world) = &self.world {
+            signal(world, Signal::SIGKILL);
+        }
+        for agent in self.agents.iter().flatten() {
+            let _ = agent.wait();
+        }
+        if let Some(world) = &mut self.world {
+            let _ = world.wait();
         }
         self.agents.clear();
         self.world = None;

@@ -380,6 +380,16 @@ impl AgentLink {
     }
 }
 
+impl AgentLink {
+    /// Lets go of a run the world has ended without taking down this agent's iceoryx2 node one file at a time:
+    /// the process is about to exit, and whoever created the run removes its shared memory as a whole. A robot
+    /// that leaves a run still going drops its link instead, so a later agent can have its place.
+    pub fn release_ended_run(self) {
+        self.sync.leave(self.robot);
+        std::mem::forget(self);
+    }
+}
+
 impl Drop for AgentLink {
     fn drop(&mut self) {
         self.sync.leave(self.robot);

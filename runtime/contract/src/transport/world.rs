@@ -355,6 +355,10 @@ impl WorldLink {
     fn serve_board_requests(&mut self) {
         let requests = self.deaths.sync.board_requests();
         if requests != self.board_requests_handled {
+            tracing::debug!(
+                requests = requests - self.board_requests_handled,
+                "fresh command boards requested"
+            );
             self.board_requests_handled = requests;
             self.renew_requested_boards();
             self.cleaner.request();
@@ -369,6 +373,15 @@ impl WorldLink {
     /// Death notice from the world's own thread; see [`DeathNotices::mark_dead`].
     pub fn mark_dead(&self, robot: u32) -> Result<(), TransportError> {
         self.deaths.mark_dead(robot)
+    }
+
+    /// Every robot starts without an agent: it counts as present only once its agent has connected. Unlike a
+    /// death notice this asks for no dead-node cleanup, as no agent has lived yet (at 1,000 robots a cleanup scan
+    /// takes half a second of a core, which the first ticks would otherwise share).
+    pub fn start_without_agents(&self) {
+        for robot in 0..self.config.robots {
+            self.deaths.sync.mark_dead(robot);
+        }
     }
 
     /// Whether `robot` has a connected agent without a death notice (e.g. a replacement agent has joined).
@@ -521,6 +534,11 @@ impl WorldLink {
         if notices != self.notices_handled
             || tick - self.last_cleanup >= self.config.cleanup_interval
         {
+            tracing::debug!(
+                tick,
+                notices = notices - self.notices_handled,
+                "dead-node cleanup requested"
+            );
             self.notices_handled = notices;
             self.last_cleanup = tick;
             self.cleaner.request();
@@ -584,6 +602,16 @@ fn every_entry<T: Copy + ZeroCopySend>(
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((writer, entries))
+}
+
+impl WorldLink {
+    /// Ends the run for the agents (as dropping the link does) without taking down the run's services one by
+    /// one: the process is about to exit, and whoever created the run removes its shared memory as a whole
+    /// ([`RunSpec::cleanup`]). At 1,000 robots the orderly teardown took 0.4 s of the world's exit.
+    pub fn end_run(self) {
+        self.deaths.sync.stop();
+        std::mem::forget(self);
+    }
 }
 
 impl Drop for WorldLink {
