@@ -9,7 +9,10 @@
 //! Bare: the lockstep round trip with no world work and no player ([`bare`]), next to the same-hour floor of a
 //! minimal futex-broadcast lockstep ([`floor`]). Real time: one paced run (e.g. 2,000 agents at 10 ticks/s) and
 //! whether every tick kept its slot.
+//! ARGoS side by side (`--argos <prefix>`, [`argos`]): per N the same experiment run by ARGoS headless with its own
+//! e-puck obstacle-avoidance example controller, alternating with ours, both timed as whole runs, start to exit.
 
+pub mod argos;
 pub mod bare;
 pub mod floor;
 pub mod rss;
@@ -18,10 +21,12 @@ pub mod stats;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 use serde::Serialize;
 
 use crate::launcher::{self, LaunchError, RunOptions};
+use argos::{ArgosError, ArgosFigures, ArgosInstall, Engine};
 use bare::{BareError, BareOptions};
 use rss::RssSampler;
 use stats::median;
@@ -51,7 +56,12 @@ pub struct BenchOptions {
     pub real_time_robots: Option<u32>,
     /// Ticks of the real-time check.
     pub real_time_ticks: u64,
+    /// Also run ARGoS on the same experiment, alternating with ours (`None`: ours only).
+    pub argos: Option<ArgosInstall>,
 }
+
+/// The seed of every whole-system run, ours and ARGoS'.
+pub const SEED: u32 = 1;
 
 /// Whole-system figures for one robot count (medians over the runs).
 #[derive(Debug, Clone, Serialize)]
@@ -86,6 +96,9 @@ pub struct SystemFigures {
     pub cpu_agents_us_per_robot_step: f64,
     /// Median over the runs of the world process's CPU time per tick (every thread), in microseconds.
     pub cpu_world_us_per_tick: f64,
+    /// ARGoS on the same experiment, run in alternation with ours (with `--argos`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub argos: Option<ArgosFigures>,
 }
 
 /// Bare lockstep figures for one robot count.
@@ -182,6 +195,15 @@ pub enum BenchError {
         /// Why.
         source: std::io::Error,
     },
+    /// ARGoS could not be run beside ours.
+    #[error("ARGoS side by side with {robots} robots")]
+    Argos {
+        /// Robots.
+        robots: u32,
+        /// Why.
+        #[source]
+        source: ArgosError,
+    },
     /// Ctrl-C.
     #[error("interrupted")]
     Interrupted,
@@ -255,20 +277,30 @@ fn density_config(options: &BenchOptions, robots: u32) -> PathBuf {
     options.configs_dir.join(format!("density_N{robots}.argos"))
 }
 
-/// One launcher run without progress bar; returns its summary.json and the agents' peak RSS in KiB.
+/// What one launcher run gave.
+struct Measured {
+    /// Its summary.json.
+    summary: serde_json::Value,
+    /// The agents' peak RSS in KiB.
+    peaks: Vec<f64>,
+    /// Wall time of the launcher's call, configuration read to the last process gone, in seconds.
+    elapsed_seconds: f64,
+}
+
+/// One launcher run without progress bar.
 fn measured_run(
     config: &Path,
     out: PathBuf,
     ticks: u64,
     real_time: bool,
     stop: &Arc<AtomicBool>,
-) -> Result<(serde_json::Value, Vec<f64>), BenchError> {
+) -> Result<Measured, BenchError> {
     check_stop(stop)?;
     let _ = std::fs::remove_dir_all(&out);
     let run_options = RunOptions {
         config: config.to_path_buf(),
         ticks: Some(ticks),
-        seed: Some(1),
+        seed: Some(u64::from(SEED)),
         out: Some(out),
         overwrite: true,
         progress: false,
@@ -276,7 +308,9 @@ fn measured_run(
         ..RunOptions::default()
     };
     let sampler = RssSampler::start(AGENT_PROGRAM);
+    let started = Instant::now();
     let result = launcher::run(&run_options, Arc::clone(stop));
+    let elapsed_seconds = started.elapsed().as_secs_f64();
     let peaks = sampler.finish();
     let report = result.map_err(|source| BenchError::Run {
         config: config.to_path_buf(),
@@ -293,7 +327,11 @@ fn measured_run(
             path: path.clone(),
             what: "missing or not JSON".into(),
         })?;
-    Ok((summary, peaks.into_values().map(|kib| kib as f64).collect()))
+    Ok(Measured {
+        summary,
+        peaks: peaks.into_values().map(|kib| kib as f64).collect(),
+        elapsed_seconds,
+    })
 }
 
 fn figure(summary: &serde_json::Value, key: &str, path: &Path) -> Result<f64, BenchError> {
@@ -306,6 +344,67 @@ fn figure(summary: &serde_json::Value, key: &str, path: &Path) -> Result<f64, Be
         })
 }
 
+/// Our runs' figures for one size, in run order.
+#[derive(Debug, Default)]
+struct Samples {
+    rates: Vec<f64>,
+    p50s: Vec<f64>,
+    p99s: Vec<f64>,
+    first_ticks: Vec<f64>,
+    walls: Vec<f64>,
+    afters: Vec<f64>,
+    rss: Vec<f64>,
+    agents_cpu: Vec<f64>,
+    world_cpu: Vec<f64>,
+    /// The launcher call's wall time (the figure compared with ARGoS').
+    elapsed: Vec<f64>,
+}
+
+impl Samples {
+    /// Adds one run; `path` names its summary.json in messages.
+    fn push(&mut self, measured: Measured, path: &Path) -> Result<(), BenchError> {
+        let summary = &measured.summary;
+        self.rates
+            .push(figure(summary, "robot_steps_per_second", path)?);
+        self.p50s.push(figure(summary, "tick_micros_p50", path)?);
+        self.p99s.push(figure(summary, "tick_micros_p99", path)?);
+        let first_tick = figure(summary, "time_to_first_tick_seconds", path)?;
+        let wall = figure(summary, "wall_seconds", path)?;
+        let ticking = figure(summary, "ticking_seconds", path)?;
+        self.first_ticks.push(first_tick);
+        self.walls.push(wall);
+        self.afters.push((wall - first_tick - ticking).max(0.0));
+        self.agents_cpu
+            .push(figure(summary, "cpu_agents_us_per_robot_step", path)?);
+        self.world_cpu
+            .push(figure(summary, "cpu_world_us_per_tick", path)?);
+        self.rss.extend(measured.peaks);
+        self.elapsed.push(measured.elapsed_seconds);
+        Ok(())
+    }
+
+    /// The medians.
+    fn figures(self, robots: u32, ticks: u64) -> SystemFigures {
+        SystemFigures {
+            robots,
+            runs: self.rates.len(),
+            ticks,
+            robot_steps_per_second: median(&self.rates).unwrap_or(0.0),
+            tick_p50_us: median(&self.p50s).unwrap_or(0.0),
+            tick_p99_us: median(&self.p99s).unwrap_or(0.0),
+            first_tick_seconds: median(&self.first_ticks).unwrap_or(0.0),
+            wall_seconds: median(&self.walls).unwrap_or(0.0),
+            after_last_tick_seconds: median(&self.afters).unwrap_or(0.0),
+            agent_peak_rss_kib_median: median(&self.rss).unwrap_or(0.0),
+            agent_peak_rss_kib_max: self.rss.iter().copied().fold(0.0, f64::max),
+            cpu_agents_us_per_robot_step: median(&self.agents_cpu).unwrap_or(0.0),
+            cpu_world_us_per_tick: median(&self.world_cpu).unwrap_or(0.0),
+            robot_steps_per_second_runs: self.rates,
+            argos: None,
+        }
+    }
+}
+
 fn system(
     options: &BenchOptions,
     robots: u32,
@@ -315,52 +414,42 @@ fn system(
     let ticks = options
         .ticks
         .unwrap_or_else(|| (200_000 / u64::from(robots)).clamp(200, 2000));
-    let mut rates = Vec::new();
-    let mut p50s = Vec::new();
-    let mut p99s = Vec::new();
-    let mut first_ticks = Vec::new();
-    let mut walls = Vec::new();
-    let mut afters = Vec::new();
-    let mut rss = Vec::new();
-    let mut agents_cpu = Vec::new();
-    let mut world_cpu = Vec::new();
-    for repetition in 0..options.repeat.max(1) {
-        let out = options.out.join(format!("system_N{robots}_{repetition}"));
-        let summary_path = out.join(SUMMARY_FILE);
-        let (summary, peaks) = measured_run(&config, out, ticks, false, stop)?;
-        rates.push(figure(&summary, "robot_steps_per_second", &summary_path)?);
-        p50s.push(figure(&summary, "tick_micros_p50", &summary_path)?);
-        p99s.push(figure(&summary, "tick_micros_p99", &summary_path)?);
-        let first_tick = figure(&summary, "time_to_first_tick_seconds", &summary_path)?;
-        let wall = figure(&summary, "wall_seconds", &summary_path)?;
-        let ticking = figure(&summary, "ticking_seconds", &summary_path)?;
-        first_ticks.push(first_tick);
-        walls.push(wall);
-        afters.push((wall - first_tick - ticking).max(0.0));
-        agents_cpu.push(figure(
-            &summary,
-            "cpu_agents_us_per_robot_step",
-            &summary_path,
-        )?);
-        world_cpu.push(figure(&summary, "cpu_world_us_per_tick", &summary_path)?);
-        rss.extend(peaks);
+    let argos_error = |source| BenchError::Argos { robots, source };
+    let argos_config = options.out.join(format!("argos_N{robots}.argos"));
+    if options.argos.is_some() {
+        argos::write_config(&config, &argos_config, ticks, SEED).map_err(argos_error)?;
     }
-    Ok(SystemFigures {
-        robots,
-        runs: rates.len(),
-        ticks,
-        robot_steps_per_second: median(&rates).unwrap_or(0.0),
-        robot_steps_per_second_runs: rates,
-        tick_p50_us: median(&p50s).unwrap_or(0.0),
-        tick_p99_us: median(&p99s).unwrap_or(0.0),
-        first_tick_seconds: median(&first_ticks).unwrap_or(0.0),
-        wall_seconds: median(&walls).unwrap_or(0.0),
-        after_last_tick_seconds: median(&afters).unwrap_or(0.0),
-        agent_peak_rss_kib_median: median(&rss).unwrap_or(0.0),
-        agent_peak_rss_kib_max: rss.iter().copied().fold(0.0, f64::max),
-        cpu_agents_us_per_robot_step: median(&agents_cpu).unwrap_or(0.0),
-        cpu_world_us_per_tick: median(&world_cpu).unwrap_or(0.0),
-    })
+    let mut samples = Samples::default();
+    let mut argos_walls = Vec::new();
+    for turn in argos::schedule(options.repeat, options.argos.is_some()) {
+        check_stop(stop)?;
+        match (turn.engine, &options.argos) {
+            (Engine::Ours, _) => {
+                let out = options
+                    .out
+                    .join(format!("system_N{robots}_{}", turn.repetition));
+                let summary_path = out.join(SUMMARY_FILE);
+                let measured = measured_run(&config, out, ticks, false, stop)?;
+                samples.push(measured, &summary_path)?;
+            }
+            (Engine::Argos, Some(install)) => {
+                let log = options
+                    .out
+                    .join(format!("argos_N{robots}_{}.log", turn.repetition));
+                let result = install.run(&argos_config, &log);
+                // Ctrl-C reaches ARGoS too: its failure is then the interruption.
+                check_stop(stop)?;
+                argos_walls.push(result.map_err(argos_error)?.as_secs_f64());
+            }
+            (Engine::Argos, None) => {}
+        }
+    }
+    let ours_elapsed = samples.elapsed.clone();
+    let mut figures = samples.figures(robots, ticks);
+    if options.argos.is_some() {
+        figures.argos = Some(ArgosFigures::new(argos_config, ours_elapsed, argos_walls));
+    }
+    Ok(figures)
 }
 
 fn real_time(
@@ -371,7 +460,7 @@ fn real_time(
     let config = density_config(options, robots);
     let out = options.out.join(format!("real_time_N{robots}"));
     let summary_path = out.join(SUMMARY_FILE);
-    let (summary, _) = measured_run(&config, out, options.real_time_ticks, true, stop)?;
+    let summary = measured_run(&config, out, options.real_time_ticks, true, stop)?.summary;
     Ok(RealTimeFigures {
         robots,
         ticks: figure(&summary, "ticks", &summary_path)? as u64,
@@ -409,6 +498,29 @@ pub fn markdown(report: &BenchReport) -> String {
                 f.agent_peak_rss_kib_max / 1024.0,
                 f.cpu_agents_us_per_robot_step,
                 f.cpu_world_us_per_tick,
+            ));
+        }
+    }
+    let compared: Vec<(&SystemFigures, &ArgosFigures)> = report
+        .system
+        .iter()
+        .filter_map(|f| f.argos.as_ref().map(|a| (f, a)))
+        .collect();
+    if !compared.is_empty() {
+        text.push_str(
+            "\n| N (ours vs ARGoS, alternated) | runs x ticks | ours, start to exit | ARGoS, start to exit | ARGoS / ours |\n\
+             |---|---|---|---|---|\n",
+        );
+        for (f, a) in compared {
+            text.push_str(&format!(
+                "| {} | {} x {} | {:.2} s | {:.2} s | {:.2} ({}) |\n",
+                f.robots,
+                a.runs,
+                f.ticks,
+                a.ours_wall_seconds,
+                a.wall_seconds,
+                a.argos_over_ours,
+                a.verdict(),
             ));
         }
     }

@@ -273,6 +273,14 @@ struct BenchArgs {
     /// Ticks of the real-time check.
     #[arg(long, default_value_t = swarm_cli::bench::DEFAULT_REAL_TIME_TICKS)]
     real_time_ticks: u64,
+    /// Also run ARGoS headless on the same experiment per size, alternating with ours, and compare whole-run wall
+    /// times: an ARGoS install prefix (holding bin/argos3 and lib/argos3).
+    #[arg(long, value_name = "PREFIX", conflicts_with = "no_system")]
+    argos: Option<PathBuf>,
+    /// The argos3-examples work tree with its build/ (the e-puck obstacle-avoidance controller); ARGoS runs from
+    /// there [default: <PREFIX>/../argos3-examples].
+    #[arg(long, value_name = "DIR", requires = "argos")]
+    argos_examples: Option<PathBuf>,
 }
 
 /// Flags of `swarm host`.
@@ -342,6 +350,13 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
+    let argos = args
+        .argos
+        .as_deref()
+        .map(|prefix| {
+            swarm_cli::bench::argos::ArgosInstall::locate(prefix, args.argos_examples.as_deref())
+        })
+        .transpose()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let options = BenchOptions {
@@ -354,6 +369,7 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         bare: !args.no_bare,
         real_time_robots: args.real_time_robots,
         real_time_ticks: args.real_time_ticks,
+        argos,
     };
     let progress = indicatif::ProgressBar::new_spinner();
     progress.enable_steady_tick(Duration::from_millis(200));
