@@ -243,8 +243,9 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             object.extend(cpu);
         }
     }
-    recorder.finish(&world, extra)?;
+    // The agents exit while the records are finished (the final snapshot alone takes 0.2 s at 1,000 robots).
     link.end();
+    recorder.finish(&world, extra)?;
     report(WorldReport::Finished { ticks });
     Ok(())
 }
