@@ -7,21 +7,21 @@ use crate::product::{ProductOutput, product_with_tuples};
 
 /// The control data of a supervisor in closed loop with its plant.
 pub(super) struct ControlData<'a> {
-    pub(super) events: &'a EventTable,
+    events: &'a EventTable,
     /// S restricted to the transitions the closed loop takes, in breadth-first order (initial state 0).
-    pub(super) sup: Automaton,
+    sup: Automaton,
     /// Local index of each event id in Σ(S) (`usize::MAX` outside it).
-    pub(super) local: Vec<usize>,
+    local: Vec<usize>,
     /// Number of events in Σ(S).
-    pub(super) width: usize,
+    width: usize,
     /// Bit sets over Σ(S), `words` words per state.
-    pub(super) words: usize,
-    pub(super) enabled: Vec<u64>,
-    pub(super) disabled: Vec<u64>,
+    words: usize,
+    enabled: Vec<u64>,
+    disabled: Vec<u64>,
     /// T(x): paired with a marked plant state.
-    pub(super) plant_marked: Vec<bool>,
+    plant_marked: Vec<bool>,
     /// x has a controllable transition with a lower bound above 0.
-    pub(super) timed: Vec<bool>,
+    timed: Vec<bool>,
 }
 
 impl<'a> ControlData<'a> {
@@ -79,19 +79,19 @@ impl<'a> ControlData<'a> {
         self.sup.state_count()
     }
 
-    pub(super) fn local_of(&self, event: EventId) -> usize {
+    fn local_of(&self, event: EventId) -> usize {
         self.local[event.index()]
     }
 
     /// Whether x and y may share a cell (conditions 1-4 of the module documentation).
-    pub(super) fn consistent(&self, x: usize, y: usize) -> bool {
+    fn consistent(&self, x: usize, y: usize) -> bool {
         self.control_consistent(x, y)
             && self.marking_consistent(x, y)
             && self.labels_agree(x, y)
             && self.timers_allow(x, y)
     }
 
-    pub(super) fn control_consistent(&self, x: usize, y: usize) -> bool {
+    fn control_consistent(&self, x: usize, y: usize) -> bool {
         let w = self.words;
         let (ex, ey) = (
             &self.enabled[x * w..(x + 1) * w],
@@ -104,12 +104,12 @@ impl<'a> ControlData<'a> {
         (0..w).all(|i| ex[i] & dy[i] == 0 && ey[i] & dx[i] == 0)
     }
 
-    pub(super) fn marking_consistent(&self, x: usize, y: usize) -> bool {
+    fn marking_consistent(&self, x: usize, y: usize) -> bool {
         let marked = |s: usize| self.sup.is_marked(StateId(s as u32));
         !(self.plant_marked[x] && self.plant_marked[y] && marked(x) != marked(y))
     }
 
-    pub(super) fn labels_agree(&self, x: usize, y: usize) -> bool {
+    fn labels_agree(&self, x: usize, y: usize) -> bool {
         let ty = self.sup.transitions(StateId(y as u32));
         self.sup
             .transitions(StateId(x as u32))
@@ -121,12 +121,12 @@ impl<'a> ControlData<'a> {
             })
     }
 
-    pub(super) fn timers_allow(&self, x: usize, y: usize) -> bool {
+    fn timers_allow(&self, x: usize, y: usize) -> bool {
         !self.enters_timed(x, y) && !self.enters_timed(y, x)
     }
 
     /// Whether a transition leads from `from` to a different state `to` that has a timed transition.
-    pub(super) fn enters_timed(&self, from: usize, to: usize) -> bool {
+    fn enters_timed(&self, from: usize, to: usize) -> bool {
         self.timed[to]
             && from != to
             && self
@@ -177,11 +177,11 @@ impl<'a> ControlData<'a> {
 /// What the closed loop G ∥ S says about each state of S (bit sets over Σ(S), `words` words per state).
 struct Scan {
     /// Events defined in S and possible in a paired plant state: the transitions the closed loop takes.
-    pub(super) used: Vec<u64>,
+    used: Vec<u64>,
     /// Events possible in a paired plant state but not defined in S: D(x).
-    pub(super) disabled: Vec<u64>,
+    disabled: Vec<u64>,
     /// Paired with a marked plant state: T(x).
-    pub(super) plant_marked: Vec<bool>,
+    plant_marked: Vec<bool>,
 }
 
 impl Scan {
@@ -273,20 +273,20 @@ fn restrict_to_used(
 }
 
 /// One union, as recorded for undoing it.
-pub(super) struct Union {
-    pub(super) child: u32,
-    pub(super) root: u32,
-    pub(super) least_before: u32,
+struct Union {
+    child: u32,
+    root: u32,
+    least_before: u32,
 }
 
 /// A partition of states into cells: union-find without path compression (so unions can be undone in reverse
 /// order), each cell's members on a circular list, and each cell's least member.
 pub(super) struct Cells {
-    pub(super) parent: Vec<u32>,
-    pub(super) size: Vec<u32>,
-    pub(super) least: Vec<u32>,
-    pub(super) next: Vec<u32>,
-    pub(super) trail: Vec<Union>,
+    parent: Vec<u32>,
+    size: Vec<u32>,
+    least: Vec<u32>,
+    next: Vec<u32>,
+    trail: Vec<Union>,
 }
 
 impl Cells {
@@ -380,7 +380,7 @@ impl Cells {
 }
 
 /// How a tentative merge ended.
-pub(super) enum Attempt {
+enum Attempt {
     Merged,
     Inconsistent,
     OutOfBudget,
@@ -388,13 +388,13 @@ pub(super) enum Attempt {
 
 /// The greedy merge over the control data.
 pub(super) struct Merger<'a> {
-    pub(super) data: &'a ControlData<'a>,
+    data: &'a ControlData<'a>,
     pub(super) cells: Cells,
-    pub(super) budget: u64,
-    pub(super) left: Vec<usize>,
-    pub(super) right: Vec<usize>,
+    budget: u64,
+    left: Vec<usize>,
+    right: Vec<usize>,
     /// The successor of the left cell under each local event (`u32::MAX` for none).
-    pub(super) successor: Vec<u32>,
+    successor: Vec<u32>,
 }
 
 impl<'a> Merger<'a> {
@@ -435,7 +435,7 @@ impl<'a> Merger<'a> {
     }
 
     /// Merges the cells of i and j and, recursively, the cells of their common successors.
-    pub(super) fn try_merge(&mut self, i: usize, j: usize) -> Attempt {
+    fn try_merge(&mut self, i: usize, j: usize) -> Attempt {
         let mut pending = vec![(i, j)];
         while let Some((a, b)) = pending.pop() {
             let (ra, rb) = (self.cells.find(a), self.cells.find(b));
@@ -454,7 +454,7 @@ impl<'a> Merger<'a> {
     }
 
     /// Checks every pair of `left` × `right`; `None` if all are consistent.
-    pub(super) fn check_members(&mut self) -> Option<Attempt> {
+    fn check_members(&mut self) -> Option<Attempt> {
         for &x in &self.left {
             for &y in &self.right {
                 if self.budget == 0 {
@@ -470,7 +470,7 @@ impl<'a> Merger<'a> {
     }
 
     /// Adds to `pending` the pair of successors of `left` and `right` under each event both define.
-    pub(super) fn successor_pairs(&mut self, pending: &mut Vec<(usize, usize)>) {
+    fn successor_pairs(&mut self, pending: &mut Vec<(usize, usize)>) {
         let sup = &self.data.sup;
         for &x in &self.left {
             for t in sup.transitions(StateId(x as u32)) {

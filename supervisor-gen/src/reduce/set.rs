@@ -360,7 +360,7 @@ impl<'a> Costs<'a> {
     }
 
     /// The subset of `candidates` to use with the least total (fewer reductions on ties), trying every subset.
-    pub(super) fn cheapest(&self, candidates: &[usize]) -> Vec<bool> {
+    fn cheapest(&self, candidates: &[usize]) -> Vec<bool> {
         let pick = |mask: u64| -> Vec<bool> {
             let mut used = vec![false; self.before.len()];
             for (bit, &i) in candidates.iter().enumerate() {
