@@ -242,9 +242,10 @@ pub fn compiled_supervisors(run_dir: &Path, controller: &str) -> std::io::Result
         .join(format!("{controller}.ptsct")))
 }
 
-/// The last `lines` non-empty lines of a log, for error messages.
+/// The last `lines` non-empty lines of a log, for error messages (bytes that are not UTF-8 shown as U+FFFD).
 pub fn tail(path: &Path, lines: usize) -> String {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let bytes = std::fs::read(path).unwrap_or_default();
+    let text = String::from_utf8_lossy(&bytes);
     let kept: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
     kept[kept.len().saturating_sub(lines)..].join("\n")
 }

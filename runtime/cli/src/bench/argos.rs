@@ -19,6 +19,7 @@ use quick_xml::Reader;
 use quick_xml::escape::escape;
 use quick_xml::events::{BytesStart, Event};
 use serde::Serialize;
+use swarm_contract::run_dir;
 
 use super::stats::median;
 
@@ -462,7 +463,7 @@ impl ArgosInstall {
                 dir: self.examples.clone(),
                 status: status.to_string(),
                 log: log.to_path_buf(),
-                tail: tail(log, TAIL_LINES),
+                tail: run_dir::tail(log, TAIL_LINES),
             })
         }
     }
@@ -473,14 +474,6 @@ fn absolute(path: &Path) -> Result<PathBuf, ArgosError> {
         path: path.to_path_buf(),
         source,
     })
-}
-
-/// The last `lines` non-empty lines of the file `path` (what can be read of it).
-fn tail(path: &Path, lines: usize) -> String {
-    let bytes = std::fs::read(path).unwrap_or_default();
-    let text = String::from_utf8_lossy(&bytes);
-    let kept: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
-    kept[kept.len().saturating_sub(lines)..].join("\n")
 }
 
 /// Which program a run of the comparison runs.
