@@ -153,7 +153,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         .map(|i| ActuatorCommand::idle(i as u32, 0))
         .collect();
     faults.wait_for_agents(&mut link, &mut world, &mut recorder, &commands)?;
-    let (mut cpu, mut cpu_marked) = (None, false);
+    let mut cpu = None;
     let started = Instant::now();
     let mut pacer = Pacer::new(args.real_time, experiment.framework.ticks_per_second);
     let mut has_command = vec![false; robots];
@@ -204,8 +204,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
                 dead: outcome.dead,
             });
         }
-        if !cpu_marked {
-            cpu_marked = true;
+        if outcome.tick == 1 {
             cpu = TickingCpu::start(&link, robot_steps);
         }
         pacer.end_of_tick(outcome.tick);
