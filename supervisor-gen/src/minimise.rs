@@ -2,185 +2,275 @@
 //!
 //! Partition refinement on the accessible part, starting from {marked, unmarked}. A transition's label is the
 //! triple (event, P in Q0.16, T), so probabilities are compared by their stored encoding, never as raw floats.
-//! The refinement is Valmari and Lehtinen's O(m log n) algorithm for partial transition functions ("Efficient
-//! minimization of DFAs with partial transition functions", STACS 2008): states and transitions live in two
-//! refinable partitions over flat arrays, so nothing is allocated per state or per round.
+//!
+//! The refinement is Hopcroft's algorithm on the automaton completed by an implicit sink state. The sink sits in
+//! a block of its own that never splits, so it is the one block Hopcroft's "all but one" rule leaves out as a
+//! splitter, and the transitions into it are never enumerated: the work is O(m log n) over the real transitions.
+//! A splitter block is taken with all its labels at once (its incoming transitions bucketed by label), and blocks
+//! are processed in creation order: a split keeps the larger half under the old id, so a block processed earlier
+//! gets only its smaller half back as a splitter. Every array the refinement touches at random is indexed by
+//! state, so it stays in cache far longer than a partition of the transitions would.
 //! This is not supervisor reduction (control covers): only language-equivalent states with equal labels merge.
+
+use std::borrow::Cow;
+use std::collections::HashMap;
 
 use crate::automaton::{Automaton, StateId};
 use crate::compiled::prob_to_q16;
-use crate::trim::accessible;
+use crate::trim::{accessible_mask, restrict};
 
 /// The minimal automaton with the same language, marked language and P/T labels as `a`'s accessible part.
 ///
 /// State names are those of each class's first state; the initial state's class becomes state 0.
 pub fn minimise(a: &Automaton) -> Automaton {
-    let a = accessible(a);
+    let a = accessible_part(a);
     let n = a.state_count();
     if n == 0 {
-        return a;
+        return a.into_owned();
     }
-    // Flat transition arrays: tail (source), head (target), label.
-    let m = a.transition_count();
-    let mut tail = Vec::with_capacity(m);
-    let mut head = Vec::with_capacity(m);
-    let mut label = Vec::with_capacity(m);
-    for x in a.states() {
-        for t in a.transitions(x) {
-            tail.push(x.0);
-            head.push(t.target.0);
-            label.push(
-                (u64::from(t.event.0) << 48)
-                    | (u64::from(prob_to_q16(t.prob)) << 32)
-                    | u64::from(t.lower_bound),
-            );
-        }
-    }
-    // Incoming transitions of each state: in_trans[in_first[s]..in_first[s + 1]].
-    let mut in_first = vec![0usize; n + 1];
-    for &h in &head {
-        in_first[h as usize + 1] += 1;
-    }
-    for i in 0..n {
-        in_first[i + 1] += in_first[i];
-    }
-    let mut fill = in_first.clone();
-    let mut in_trans = vec![0u32; m];
-    for (t, &h) in head.iter().enumerate() {
-        in_trans[fill[h as usize]] = t as u32;
-        fill[h as usize] += 1;
-    }
-
-    let mut marks = Marks::new(n.max(m) + 1);
+    let incoming = Incoming::new(&a);
     let mut blocks = Partition::new(n);
     for x in 0..n {
         if a.is_marked(StateId(x as u32)) {
-            blocks.mark(x, &mut marks);
+            blocks.mark(x as u32);
         }
     }
-    blocks.split(&mut marks);
-    let mut cords = Partition::new(m);
-    if m > 0 {
-        cords.elems.sort_unstable_by_key(|&t| label[t as usize]);
-        cords.sets = 0;
-        let mut current = label[cords.elems[0] as usize];
-        cords.first[0] = 0;
-        for i in 0..m {
-            let t = cords.elems[i] as usize;
-            if label[t] != current {
-                current = label[t];
-                cords.past[cords.sets] = i;
-                cords.sets += 1;
-                cords.first[cords.sets] = i;
+    blocks.split();
+    let mut buckets = Buckets::new(incoming.letters);
+    let mut b = 0;
+    while b < blocks.sets.len() {
+        let range = blocks.sets[b];
+        buckets.gather(
+            blocks.elems[range.first as usize..range.past as usize]
+                .iter()
+                .flat_map(|&s| incoming.of(s)),
+        );
+        for group in buckets.groups() {
+            for &p in group {
+                blocks.mark(p);
             }
-            cords.set_of[t] = cords.sets as u32;
-            cords.loc[t] = i as u32;
+            blocks.split();
         }
-        cords.past[cords.sets] = m;
-        cords.sets += 1;
+        b += 1;
     }
-    // Block 0 never needs to act as a splitter (Hopcroft's "all but one" argument; cords cover the rest).
-    let (mut b, mut c) = (1usize, 0usize);
-    while c < cords.sets {
-        for i in cords.first[c]..cords.past[c] {
-            blocks.mark(tail[cords.elems[i] as usize] as usize, &mut marks);
-        }
-        blocks.split(&mut marks);
-        c += 1;
-        while b < blocks.sets {
-            for i in blocks.first[b]..blocks.past[b] {
-                let s = blocks.elems[i] as usize;
-                for &t in &in_trans[in_first[s]..in_first[s + 1]] {
-                    cords.mark(t as usize, &mut marks);
-                }
-            }
-            cords.split(&mut marks);
-            b += 1;
-        }
-    }
-    let mut class: Vec<u32> = blocks.set_of.clone();
+    let mut class: Vec<u32> = blocks.places.iter().map(|p| p.set).collect();
     let classes = renumber(&mut class);
     quotient(&a, &class, classes)
 }
 
-/// Per-set mark counts and the worklist of touched sets, shared by both partitions (used one at a time).
-struct Marks {
-    count: Vec<usize>,
-    touched: Vec<usize>,
-}
-
-impl Marks {
-    fn new(capacity: usize) -> Self {
-        Self {
-            count: vec![0; capacity],
-            touched: Vec::with_capacity(capacity),
-        }
+/// `a` itself when every state is accessible (as after SupC), else its accessible part.
+fn accessible_part(a: &Automaton) -> Cow<'_, Automaton> {
+    let keep = accessible_mask(a, &vec![false; a.state_count()]);
+    if keep.iter().all(|&k| k) {
+        Cow::Borrowed(a)
+    } else {
+        Cow::Owned(restrict(a, &keep).0)
     }
 }
 
-/// A refinable partition of `0..n`: set s holds `elems[first[s]..past[s]]`, marked elements first.
+/// Incoming transitions of every state as (source, letter) pairs, letters being dense ids of the distinct labels.
+struct Incoming {
+    first: Vec<u32>,
+    sources: Vec<u32>,
+    letter: Vec<u32>,
+    letters: usize,
+}
+
+impl Incoming {
+    fn new(a: &Automaton) -> Self {
+        let n = a.state_count();
+        let mut first = vec![0u32; n + 1];
+        for x in a.states() {
+            for t in a.transitions(x) {
+                first[t.target.index() + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            first[i + 1] += first[i];
+        }
+        let m = first[n] as usize;
+        let mut fill = first.clone();
+        let mut sources = vec![0u32; m];
+        let mut letter = vec![0u32; m];
+        let mut ids: HashMap<u64, u32> = HashMap::new();
+        for x in a.states() {
+            for t in a.transitions(x) {
+                let key = (u64::from(t.event.0) << 48)
+                    | (u64::from(prob_to_q16(t.prob)) << 32)
+                    | u64::from(t.lower_bound);
+                let next = ids.len() as u32;
+                let slot = &mut fill[t.target.index()];
+                sources[*slot as usize] = x.0;
+                letter[*slot as usize] = *ids.entry(key).or_insert(next);
+                *slot += 1;
+            }
+        }
+        Self {
+            first,
+            sources,
+            letter,
+            letters: ids.len(),
+        }
+    }
+
+    /// The (source, letter) pairs of the transitions entering `y`.
+    fn of(&self, y: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let range = self.first[y as usize] as usize..self.first[y as usize + 1] as usize;
+        self.sources[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.letter[range].iter().copied())
+    }
+}
+
+/// A counting sort of a splitter's incoming pairs by letter, touching only the letters that occur.
+struct Buckets {
+    pairs: Vec<(u32, u32)>,
+    count: Vec<u32>,
+    used: Vec<u32>,
+    sources: Vec<u32>,
+}
+
+impl Buckets {
+    fn new(letters: usize) -> Self {
+        Self {
+            pairs: Vec::new(),
+            count: vec![0; letters],
+            used: Vec::new(),
+            sources: Vec::new(),
+        }
+    }
+
+    /// Takes the (source, letter) pairs of one splitter and sorts their sources by letter.
+    fn gather(&mut self, pairs: impl Iterator<Item = (u32, u32)>) {
+        for &l in &self.used {
+            self.count[l as usize] = 0;
+        }
+        self.used.clear();
+        self.pairs.clear();
+        self.pairs.extend(pairs);
+        for &(_, l) in &self.pairs {
+            if self.count[l as usize] == 0 {
+                self.used.push(l);
+            }
+            self.count[l as usize] += 1;
+        }
+        // `count` becomes each used letter's end offset while the sources are placed back to front.
+        let mut total = 0;
+        for &l in &self.used {
+            total += self.count[l as usize];
+            self.count[l as usize] = total;
+        }
+        self.sources.resize(self.pairs.len(), 0);
+        for &(p, l) in self.pairs.iter().rev() {
+            let end = &mut self.count[l as usize];
+            *end -= 1;
+            self.sources[*end as usize] = p;
+        }
+        // Now `count` holds each used letter's start offset.
+    }
+
+    /// The sources of each letter's pairs, one group per letter.
+    fn groups(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        let ends = self
+            .used
+            .iter()
+            .skip(1)
+            .map(|&l| self.count[l as usize] as usize)
+            .chain(std::iter::once(self.sources.len()));
+        self.used
+            .iter()
+            .zip(ends)
+            .map(|(&l, end)| &self.sources[self.count[l as usize] as usize..end])
+    }
+}
+
+/// Where an element is: its set and its index in `elems`.
+#[derive(Clone, Copy)]
+struct Place {
+    set: u32,
+    loc: u32,
+}
+
+/// A set's range `elems[first..past]`, its marked elements first (`marked` of them).
+#[derive(Clone, Copy)]
+struct Range {
+    first: u32,
+    past: u32,
+    marked: u32,
+}
+
+/// A refinable partition of the states `0..n`. Each record an operation touches at random is one struct, so a
+/// mark costs few cache misses.
 struct Partition {
-    sets: usize,
     elems: Vec<u32>,
-    loc: Vec<u32>,
-    set_of: Vec<u32>,
-    first: Vec<usize>,
-    past: Vec<usize>,
+    places: Vec<Place>,
+    sets: Vec<Range>,
+    touched: Vec<u32>,
 }
 
 impl Partition {
     fn new(n: usize) -> Self {
-        let mut past = vec![0; n.max(1)];
-        past[0] = n;
         Self {
-            sets: usize::from(n > 0),
             elems: (0..n as u32).collect(),
-            loc: (0..n as u32).collect(),
-            set_of: vec![0; n],
-            first: vec![0; n.max(1)],
-            past,
+            places: (0..n as u32).map(|loc| Place { set: 0, loc }).collect(),
+            sets: vec![Range {
+                first: 0,
+                past: n as u32,
+                marked: 0,
+            }],
+            touched: Vec::new(),
         }
     }
 
-    /// Marks element `e` (each element at most once between splits; a DFA guarantees this for both partitions).
-    fn mark(&mut self, e: usize, marks: &mut Marks) {
-        let s = self.set_of[e] as usize;
-        let i = self.loc[e] as usize;
-        let j = self.first[s] + marks.count[s];
-        self.elems[i] = self.elems[j];
-        self.loc[self.elems[i] as usize] = i as u32;
-        self.elems[j] = e as u32;
-        self.loc[e] = j as u32;
-        if marks.count[s] == 0 {
-            marks.touched.push(s);
+    /// Marks element `e` (each element at most once between splits: a deterministic automaton has at most one
+    /// transition per state and label).
+    fn mark(&mut self, e: u32) {
+        let Place { set, loc } = self.places[e as usize];
+        let range = &mut self.sets[set as usize];
+        let j = range.first + range.marked;
+        if range.marked == 0 {
+            self.touched.push(set);
         }
-        marks.count[s] += 1;
+        range.marked += 1;
+        let other = self.elems[j as usize];
+        self.elems[loc as usize] = other;
+        self.places[other as usize].loc = loc;
+        self.elems[j as usize] = e;
+        self.places[e as usize].loc = j;
     }
 
     /// Splits every touched set into its marked and unmarked parts; the smaller part becomes a new set.
-    fn split(&mut self, marks: &mut Marks) {
-        while let Some(s) = marks.touched.pop() {
-            let j = self.first[s] + marks.count[s];
-            if j == self.past[s] {
-                marks.count[s] = 0;
+    fn split(&mut self) {
+        while let Some(s) = self.touched.pop() {
+            let z = self.sets.len() as u32;
+            let range = &mut self.sets[s as usize];
+            let j = range.first + range.marked;
+            let marked = std::mem::take(&mut range.marked);
+            if j == range.past {
                 continue;
             }
-            let z = self.sets;
-            if marks.count[s] <= self.past[s] - j {
-                self.first[z] = self.first[s];
-                self.past[z] = j;
-                self.first[s] = j;
+            let new = if marked <= range.past - j {
+                let new = Range {
+                    first: range.first,
+                    past: j,
+                    marked: 0,
+                };
+                range.first = j;
+                new
             } else {
-                self.past[z] = self.past[s];
-                self.first[z] = j;
-                self.past[s] = j;
+                let new = Range {
+                    first: j,
+                    past: range.past,
+                    marked: 0,
+                };
+                range.past = j;
+                new
+            };
+            for &e in &self.elems[new.first as usize..new.past as usize] {
+                self.places[e as usize].set = z;
             }
-            for i in self.first[z]..self.past[z] {
-                self.set_of[self.elems[i] as usize] = z as u32;
-            }
-            marks.count[s] = 0;
-            marks.count[z] = 0;
-            self.sets += 1;
+            self.sets.push(new);
         }
     }
 }
