@@ -1,7 +1,9 @@
 //! The n-ary synchronous product of ptSCT generators (section 4), accessible part only (C2).
 //!
 //! States are tuples of component states, stored flat and indexed during construction only: by direct addressing
-//! when the full tuple space is small (at most [`DENSE_LIMIT`] tuples), otherwise by an open-addressing hash table. Shared controllable events multiply P and take the maximum T; private events keep
+//! when the full tuple space is at most [`DENSE_LIMIT`] tuples, otherwise by an open-addressing hash table. The
+//! direct-address table starts as zeroed pages the kernel maps on first touch, so a large space whose reachable
+//! part is small costs only the pages that part lands on. Shared controllable events multiply P and take the maximum T; private events keep
 //! their component's labels; uncontrollable transitions carry P = 1 and T = 0. Plant factors are whatever the
 //! caller's normalisation left in them (1 under rule A5). The product of an empty list is the identity (C3).
 
@@ -185,12 +187,13 @@ pub fn product_with_tuples(
 
 const EMPTY: u32 = u32::MAX;
 
-/// Tuple spaces up to this size are indexed by a direct-address table (4 bytes per possible tuple).
-pub const DENSE_LIMIT: usize = 1 << 22;
+/// Tuple spaces up to this size are indexed by a direct-address table (4 bytes per possible tuple, 256 MiB at
+/// most, of which only the touched pages are resident).
+pub const DENSE_LIMIT: usize = 1 << 26;
 
 /// How tuples are looked up.
 enum Lookup {
-    /// `slots[Σ t_i · stride_i]` is the id of tuple t, or EMPTY.
+    /// `slots[Σ t_i · stride_i]` is the id of tuple t plus one, or 0 if t is not yet indexed.
     Dense {
         slots: Vec<u32>,
         strides: Vec<usize>,
@@ -219,7 +222,7 @@ impl TupleIndex {
                     strides[i] = strides[i + 1] * sizes[i + 1].max(1);
                 }
                 Lookup::Dense {
-                    slots: vec![EMPTY; space],
+                    slots: vec![0; space],
                     strides,
                 }
             }
@@ -253,7 +256,7 @@ impl TupleIndex {
     /// The id stored under a direct-address key, if any (`None` also for a hashed index).
     fn dense_get(&self, key: usize) -> Option<u32> {
         match &self.lookup {
-            Lookup::Dense { slots, .. } => Some(slots[key]).filter(|&id| id != EMPTY),
+            Lookup::Dense { slots, .. } => slots[key].checked_sub(1),
             Lookup::Hashed { .. } => None,
         }
     }
@@ -262,7 +265,7 @@ impl TupleIndex {
     fn dense_insert(&mut self, key: usize, t: &[u32]) -> u32 {
         let id = self.len() as u32;
         if let Lookup::Dense { slots, .. } = &mut self.lookup {
-            slots[key] = id;
+            slots[key] = id + 1;
         }
         self.tuples.extend_from_slice(t);
         id
@@ -294,10 +297,10 @@ impl TupleIndex {
                     .zip(strides.iter())
                     .map(|(&v, &s)| v as usize * s)
                     .sum();
-                if slots[key] != EMPTY {
-                    return slots[key];
+                if let Some(found) = slots[key].checked_sub(1) {
+                    return found;
                 }
-                slots[key] = id;
+                slots[key] = id + 1;
             }
             Lookup::Hashed { table } => {
                 let mask = table.len() - 1;
@@ -406,8 +409,8 @@ mod tests {
 
     #[test]
     fn hashed_and_dense_tuple_indexes_agree() {
-        // 5000 x 5000 exceeds DENSE_LIMIT (hashed, growing); 100 x 100 does not (dense).
-        for n in [5000u32, 100] {
+        // 9000 x 9000 exceeds DENSE_LIMIT (hashed, growing); 100 x 100 does not (dense).
+        for n in [9000u32, 100] {
             let mut idx = TupleIndex::new(&[n as usize, n as usize]);
             assert_eq!(matches!(idx.lookup, Lookup::Dense { .. }), n == 100);
             for i in 0..n {
@@ -421,7 +424,7 @@ mod tests {
         }
     }
 
-    /// Two components of 2100 states (a tuple space above DENSE_LIMIT) whose reachable parts are two-state
+    /// Two components of 9000 states (a tuple space above DENSE_LIMIT) whose reachable parts are two-state
     /// cycles give the same product through the hashed index as their accessible parts give through the dense one.
     #[test]
     fn hashed_and_dense_products_agree() {
@@ -439,8 +442,8 @@ mod tests {
             g.add_transition(StateId(1), a, StateId(0), 0.5, 2).unwrap();
             g
         };
-        let (g, h) = (build("g", b, 2100), build("h", c, 2100));
-        assert!(TupleIndex::new(&[2100, 2100]).strides().is_none());
+        let (g, h) = (build("g", b, 9000), build("h", c, 9000));
+        assert!(TupleIndex::new(&[9000, 9000]).strides().is_none());
         let hashed = product_with_tuples("k", ModelKind::Spec, &ev, &[&g, &h]);
         let (gs, hs) = (build("g", b, 2), build("h", c, 2));
         let dense = product_with_tuples("k", ModelKind::Spec, &ev, &[&gs, &hs]);
