@@ -4,7 +4,8 @@
 //! problems; 3 a reduced supervisor failed its equivalence check (`synth --reduce`; nothing is written). Diagnostics go to stderr in `file:line:col: error[CODE]: message` form; summaries go to stdout.
 
 use std::collections::HashMap;
-use std::io::IsTerminal;
+use std::fs::File;
+use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -28,7 +29,7 @@ use supervisor_gen::reduce::{
 use supervisor_gen::report::{ReductionFiles, Report, SkippedOutput};
 use supervisor_gen::supc::RemovalReason;
 use supervisor_gen::validate::{CheckedModel, ValidateOptions};
-use supervisor_gen::xml_write::to_xml;
+use supervisor_gen::xml_write::write_xml;
 
 /// ptSCT toolchain: validate plant and specification automata, synthesise, minimise, draw and compile supervisors.
 ///
@@ -444,10 +445,7 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
         report = report.with_reduction(r, events, files, limits, bytes_written);
     }
     report.skipped = skipped;
-    write(
-        &out.join("report.json"),
-        report.to_json().context("cannot serialise the report")?,
-    )?;
+    write_with(&out.join("report.json"), |w| report.write_json(w))?;
     print_summary(&synthesis, reduction.as_ref(), mem_cons, out);
     for s in &report.skipped {
         eprintln!("warning: {} not written: {}", s.output, s.reason);
@@ -474,7 +472,13 @@ fn write_supervisors_xml(
     let events = &synthesis.normalised.events;
     let Some(r) = reduction else {
         return Ok(XmlFiles {
-            supervisors: write_xml(out, &synthesis.final_supervisors(), "", "", events)?,
+            supervisors: write_models(
+                out,
+                synthesis.supervisors.iter().map(|s| &s.supervisor),
+                "",
+                "",
+                events,
+            )?,
             reduced: Vec::new(),
             observers: Vec::new(),
         });
@@ -490,9 +494,9 @@ fn write_supervisors_xml(
         .filter_map(|s| s.reduced.clone())
         .collect();
     Ok(XmlFiles {
-        supervisors: write_xml(out, &finals, "", "", events)?,
-        reduced: write_xml(out, &reduced, "", ".reduced", events)?,
-        observers: write_xml(out, &r.observers, "observer_", "", events)?,
+        supervisors: write_models(out, &finals, "", "", events)?,
+        reduced: write_models(out, &reduced, "", ".reduced", events)?,
+        observers: write_models(out, &r.observers, "observer_", "", events)?,
     })
 }
 
@@ -535,17 +539,17 @@ fn write_compiled(
 }
 
 /// Writes each automaton as `<prefix><name><suffix>.xml` in `out`; returns the file names.
-fn write_xml(
+fn write_models<'a>(
     out: &Path,
-    automata: &[Automaton],
+    automata: impl IntoIterator<Item = &'a Automaton>,
     prefix: &str,
     suffix: &str,
     events: &EventTable,
 ) -> Result<Vec<String>> {
-    let mut files = Vec::with_capacity(automata.len());
+    let mut files = Vec::new();
     for a in automata {
         let file = format!("{prefix}{}{suffix}.xml", dot::file_stem(a.name()));
-        write(&out.join(&file), to_xml(a, events))?;
+        write_with(&out.join(&file), |w| write_xml(a, events, w))?;
         files.push(file);
     }
     Ok(files)
@@ -785,6 +789,18 @@ impl Drawer<'_> {
 
 fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
+/// Writes a file through a buffer as `contents` produces it.
+fn write_with(
+    path: &Path,
+    contents: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut w = BufWriter::with_capacity(1 << 20, file);
+    contents(&mut w)
+        .and_then(|()| w.flush())
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {

@@ -377,8 +377,10 @@ impl Report {
     }
 
     /// Pretty JSON (non-finite numbers become `null`).
-    pub fn to_json(&self) -> serde_json::Result<String> {
-        serde_json::to_string_pretty(self)
+    /// Writes the report as pretty JSON to `out` as it goes.
+    pub fn write_json(&self, out: &mut impl std::io::Write) -> std::io::Result<()> {
+        serde_json::to_writer_pretty(&mut *out, self)?;
+        Ok(())
     }
 }
 

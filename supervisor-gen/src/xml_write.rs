@@ -3,7 +3,7 @@
 //! ones. Probabilities are written with the shortest text that reads back to the same `f64`, so reading a written
 //! file gives the same automaton.
 
-use std::fmt::Write as _;
+use std::io::{self, Write};
 
 use quick_xml::escape::escape;
 
@@ -11,52 +11,61 @@ use crate::automaton::{Automaton, EventTable};
 
 /// Renders `automaton` as a model file of its own kind (`type="supervisor"` for synthesis results).
 pub fn to_xml(automaton: &Automaton, events: &EventTable) -> String {
-    let mut out = String::new();
+    let mut out = Vec::new();
+    write_xml(automaton, events, &mut out).expect("writing into memory cannot fail");
+    String::from_utf8(out).expect("names and the markup are UTF-8")
+}
+
+/// Writes `automaton` as a model file to `out` as it goes, so a supervisor of millions of transitions never has
+/// its whole text in memory. `out` should be buffered.
+pub fn write_xml(
+    automaton: &Automaton,
+    events: &EventTable,
+    out: &mut impl Write,
+) -> io::Result<()> {
     let flag = |b: bool| if b { "1" } else { "0" };
-    out.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    out.push_str("<!DOCTYPE automata SYSTEM \"automata.dtd\">\n");
-    // Writing into a String cannot fail.
-    let _ = writeln!(
+    out.write_all(b"<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n")?;
+    out.write_all(b"<!DOCTYPE automata SYSTEM \"automata.dtd\">\n")?;
+    writeln!(
         out,
         "<automata name=\"{}\" type=\"{}\">",
         escape(automaton.name()),
         automaton.kind()
-    );
-    out.push_str("  <states>\n");
+    )?;
+    out.write_all(b"  <states>\n")?;
     for state in automaton.states() {
-        let _ = writeln!(
+        writeln!(
             out,
             "    <state name=\"{}\" i=\"{}\" m=\"{}\"/>",
             escape(automaton.state_name(state)),
             flag(state == automaton.initial()),
             flag(automaton.is_marked(state))
-        );
+        )?;
     }
-    out.push_str("  </states>\n  <events>\n");
+    out.write_all(b"  </states>\n  <events>\n")?;
     for &event in automaton.alphabet() {
-        let _ = writeln!(
+        writeln!(
             out,
             "    <event name=\"{}\" con=\"{}\"/>",
             escape(events.name(event)),
             flag(events.is_controllable(event))
-        );
+        )?;
     }
-    out.push_str("  </events>\n  <transitions>\n");
+    out.write_all(b"  </events>\n  <transitions>\n")?;
     for state in automaton.states() {
+        let src = escape(automaton.state_name(state));
         for t in automaton.transitions(state) {
-            let _ = write!(
+            write!(
                 out,
-                "    <transition src=\"{}\" dst=\"{}\" event=\"{}\"",
-                escape(automaton.state_name(state)),
+                "    <transition src=\"{src}\" dst=\"{}\" event=\"{}\"",
                 escape(automaton.state_name(t.target)),
                 escape(events.name(t.event))
-            );
+            )?;
             if events.is_controllable(t.event) {
-                let _ = write!(out, " prob=\"{}\" time=\"{}\"", t.prob, t.lower_bound);
+                write!(out, " prob=\"{}\" time=\"{}\"", t.prob, t.lower_bound)?;
             }
-            out.push_str("/>\n");
+            out.write_all(b"/>\n")?;
         }
     }
-    out.push_str("  </transitions>\n</automata>\n");
-    out
+    out.write_all(b"  </transitions>\n</automata>\n")
 }
