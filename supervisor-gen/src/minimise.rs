@@ -53,7 +53,7 @@ pub fn minimise(a: &Automaton) -> Automaton {
         }
         b += 1;
     }
-    let mut class: Vec<u32> = blocks.places.iter().map(|p| p.set).collect();
+    let mut class: Vec<u32> = blocks.places.iter().map(|p| p.set & !ALONE).collect();
     let classes = renumber(&mut class);
     quotient(&a, &class, classes)
 }
@@ -71,8 +71,7 @@ fn accessible_part(a: &Automaton) -> Cow<'_, Automaton> {
 /// Incoming transitions of every state as (source, letter) pairs, letters being dense ids of the distinct labels.
 struct Incoming {
     first: Vec<u32>,
-    sources: Vec<u32>,
-    letter: Vec<u32>,
+    pairs: Vec<(u32, u32)>,
     letters: usize,
 }
 
@@ -90,8 +89,7 @@ impl Incoming {
         }
         let m = first[n] as usize;
         let mut fill = first.clone();
-        let mut sources = vec![0u32; m];
-        let mut letter = vec![0u32; m];
+        let mut pairs = vec![(0u32, 0u32); m];
         let mut ids: HashMap<u64, u32> = HashMap::new();
         for x in a.states() {
             for t in a.transitions(x) {
@@ -100,15 +98,13 @@ impl Incoming {
                     | u64::from(t.lower_bound);
                 let next = ids.len() as u32;
                 let slot = &mut fill[t.target.index()];
-                sources[*slot as usize] = x.0;
-                letter[*slot as usize] = *ids.entry(key).or_insert(next);
+                pairs[*slot as usize] = (x.0, *ids.entry(key).or_insert(next));
                 *slot += 1;
             }
         }
         Self {
             first,
-            sources,
-            letter,
+            pairs,
             letters: ids.len(),
         }
     }
@@ -116,10 +112,7 @@ impl Incoming {
     /// The (source, letter) pairs of the transitions entering `y`.
     fn of(&self, y: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
         let range = self.first[y as usize] as usize..self.first[y as usize + 1] as usize;
-        self.sources[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.letter[range].iter().copied())
+        self.pairs[range].iter().copied()
     }
 }
 
@@ -188,9 +181,15 @@ impl Buckets {
 /// Where an element is: its set and its index in `elems`.
 #[derive(Clone, Copy)]
 struct Place {
+    /// The set's id, with [`ALONE`] added while the element is alone in it.
     set: u32,
     loc: u32,
 }
+
+/// Flags a [`Place`] whose set has one element. Such a set never splits, so marking its element is skipped
+/// without looking the set up: once the partition is nearly final most marks land on such sets. Set ids stay
+/// below this bit because an automaton of 2^31 states would need tens of gigabytes before reaching here.
+const ALONE: u32 = 1 << 31;
 
 /// A set's range `elems[first..past]`, its marked elements first (`marked` of them).
 #[derive(Clone, Copy)]
@@ -211,9 +210,10 @@ struct Partition {
 
 impl Partition {
     fn new(n: usize) -> Self {
+        let set = if n == 1 { ALONE } else { 0 };
         Self {
             elems: (0..n as u32).collect(),
-            places: (0..n as u32).map(|loc| Place { set: 0, loc }).collect(),
+            places: (0..n as u32).map(|loc| Place { set, loc }).collect(),
             sets: vec![Range {
                 first: 0,
                 past: n as u32,
@@ -227,6 +227,9 @@ impl Partition {
     /// transition per state and label).
     fn mark(&mut self, e: u32) {
         let Place { set, loc } = self.places[e as usize];
+        if set & ALONE != 0 {
+            return;
+        }
         let range = &mut self.sets[set as usize];
         let j = range.first + range.marked;
         if range.marked == 0 {
@@ -267,8 +270,13 @@ impl Partition {
                 range.past = j;
                 new
             };
-            for &e in &self.elems[new.first as usize..new.past as usize] {
+            let moved = &self.elems[new.first as usize..new.past as usize];
+            let z = if moved.len() == 1 { z | ALONE } else { z };
+            for &e in moved {
                 self.places[e as usize].set = z;
+            }
+            if range.past - range.first == 1 {
+                self.places[self.elems[range.first as usize] as usize].set |= ALONE;
             }
             self.sets.push(new);
         }
