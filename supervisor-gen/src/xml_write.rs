@@ -2,12 +2,29 @@
 //! canonical `1`/`0` flags, explicit `prob` and `time` on every controllable transition and neither on uncontrollable
 //! ones. Probabilities are written with the shortest text that reads back to the same `f64`, so reading a written
 //! file gives the same automaton.
+//!
+//! A synthesised supervisor can have millions of transitions (a gigabyte of XML), so the text is never held whole:
+//! two threads format alternate blocks of states into buffers while the caller's thread writes them out in order.
+//! At most a few buffers are alive at a time.
 
+use std::borrow::Cow;
+use std::collections::HashMap;
 use std::io::{self, Write};
+use std::ops::Range;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use quick_xml::escape::escape;
 
-use crate::automaton::{Automaton, EventTable};
+use crate::automaton::{Automaton, EventTable, StateId};
+
+/// States formatted into one buffer.
+const STATES_PER_BLOCK: usize = 4_096;
+
+/// Threads formatting blocks.
+const FORMATTERS: usize = 2;
+
+/// Distinct probabilities whose text is remembered by each formatter.
+const PROB_CACHE: usize = 4_096;
 
 /// Renders `automaton` as a model file of its own kind (`type="supervisor"` for synthesis results).
 pub fn to_xml(automaton: &Automaton, events: &EventTable) -> String {
@@ -16,8 +33,7 @@ pub fn to_xml(automaton: &Automaton, events: &EventTable) -> String {
     String::from_utf8(out).expect("names and the markup are UTF-8")
 }
 
-/// Writes `automaton` as a model file to `out` as it goes, so a supervisor of millions of transitions never has
-/// its whole text in memory. `out` should be buffered.
+/// Writes `automaton` as a model file to `out` as it goes. `out` should be buffered.
 pub fn write_xml(
     automaton: &Automaton,
     events: &EventTable,
@@ -33,15 +49,20 @@ pub fn write_xml(
         automaton.kind()
     )?;
     out.write_all(b"  <states>\n")?;
-    for state in automaton.states() {
-        writeln!(
-            out,
-            "    <state name=\"{}\" i=\"{}\" m=\"{}\"/>",
-            escape(automaton.state_name(state)),
-            flag(state == automaton.initial()),
-            flag(automaton.is_marked(state))
-        )?;
-    }
+    write_blocks(automaton, out, |line, _, state| {
+        line.bytes(b"    <state name=\"");
+        line.name(automaton, state);
+        line.bytes(if state == automaton.initial() {
+            b"\" i=\"1\""
+        } else {
+            b"\" i=\"0\""
+        });
+        line.bytes(if automaton.is_marked(state) {
+            b" m=\"1\"/>\n"
+        } else {
+            b" m=\"0\"/>\n"
+        });
+    })?;
     out.write_all(b"  </states>\n  <events>\n")?;
     for &event in automaton.alphabet() {
         writeln!(
@@ -52,20 +73,120 @@ pub fn write_xml(
         )?;
     }
     out.write_all(b"  </events>\n  <transitions>\n")?;
-    for state in automaton.states() {
-        let src = escape(automaton.state_name(state));
+    let event_attrs: Vec<String> = events
+        .ids()
+        .map(|e| format!("\" event=\"{}\"", escape(events.name(e))))
+        .collect();
+    write_blocks(automaton, out, |line, probs, state| {
         for t in automaton.transitions(state) {
-            write!(
-                out,
-                "    <transition src=\"{src}\" dst=\"{}\" event=\"{}\"",
-                escape(automaton.state_name(t.target)),
-                escape(events.name(t.event))
-            )?;
+            line.bytes(b"    <transition src=\"");
+            line.name(automaton, state);
+            line.bytes(b"\" dst=\"");
+            line.name(automaton, t.target);
+            line.bytes(event_attrs[t.event.index()].as_bytes());
             if events.is_controllable(t.event) {
-                write!(out, " prob=\"{}\" time=\"{}\"", t.prob, t.lower_bound)?;
+                line.bytes(b" prob=\"");
+                line.bytes(probs.text(t.prob));
+                line.bytes(b"\" time=\"");
+                line.number(t.lower_bound);
+                line.bytes(b"\"");
             }
-            out.write_all(b"/>\n")?;
+            line.bytes(b"/>\n");
+        }
+    })?;
+    out.write_all(b"  </transitions>\n</automata>\n")
+}
+
+/// One formatter's output buffer.
+struct Line(Vec<u8>);
+
+impl Line {
+    fn bytes(&mut self, b: &[u8]) {
+        self.0.extend_from_slice(b);
+    }
+
+    fn name(&mut self, automaton: &Automaton, state: StateId) {
+        match escape(automaton.state_name(state)) {
+            Cow::Borrowed(plain) => self.bytes(plain.as_bytes()),
+            Cow::Owned(escaped) => self.bytes(escaped.as_bytes()),
         }
     }
-    out.write_all(b"  </transitions>\n</automata>\n")
+
+    fn number(&mut self, n: u32) {
+        let mut digits = [0u8; 10];
+        let mut at = digits.len();
+        let mut n = n;
+        loop {
+            at -= 1;
+            digits[at] = b'0' + (n % 10) as u8;
+            n /= 10;
+            if n == 0 {
+                break;
+            }
+        }
+        self.bytes(&digits[at..]);
+    }
+}
+
+/// The shortest text of each probability seen, remembered for the few distinct values a model has.
+#[derive(Default)]
+struct ProbTexts(HashMap<u64, Box<[u8]>>, String);
+
+impl ProbTexts {
+    fn text(&mut self, p: f64) -> &[u8] {
+        if self.0.len() < PROB_CACHE {
+            return self
+                .0
+                .entry(p.to_bits())
+                .or_insert_with(|| p.to_string().into_bytes().into_boxed_slice());
+        }
+        if let Some(text) = self.0.get(&p.to_bits()) {
+            return text;
+        }
+        self.1 = p.to_string();
+        self.1.as_bytes()
+    }
+}
+
+/// Formats every state of `automaton` with `line` into blocks on [`FORMATTERS`] threads and writes the blocks to
+/// `out` in state order.
+fn write_blocks<F>(automaton: &Automaton, out: &mut impl Write, line: F) -> io::Result<()>
+where
+    F: Fn(&mut Line, &mut ProbTexts, StateId) + Sync,
+{
+    let n = automaton.state_count();
+    let blocks = n.div_ceil(STATES_PER_BLOCK);
+    let block =
+        |b: usize| -> Range<usize> { b * STATES_PER_BLOCK..((b + 1) * STATES_PER_BLOCK).min(n) };
+    std::thread::scope(|scope| {
+        let mut channels: Vec<(Receiver<Vec<u8>>, SyncSender<Vec<u8>>)> = Vec::new();
+        for worker in 0..FORMATTERS {
+            let (full_tx, full_rx) = sync_channel::<Vec<u8>>(2);
+            let (empty_tx, empty_rx) = sync_channel::<Vec<u8>>(4);
+            let line = &line;
+            scope.spawn(move || {
+                let mut probs = ProbTexts::default();
+                for b in (worker..blocks).step_by(FORMATTERS) {
+                    let mut buf = Line(empty_rx.try_recv().unwrap_or_default());
+                    buf.0.clear();
+                    for x in block(b) {
+                        line(&mut buf, &mut probs, StateId(x as u32));
+                    }
+                    if full_tx.send(buf.0).is_err() {
+                        // The writer stopped on an error; it reports it.
+                        return;
+                    }
+                }
+            });
+            channels.push((full_rx, empty_tx));
+        }
+        for b in 0..blocks {
+            let (full, empty) = &channels[b % FORMATTERS];
+            let buf = full.recv().expect("a formatter sends each of its blocks");
+            out.write_all(&buf)?;
+            // A formatter that has finished no longer takes buffers back.
+            let _ = empty.try_send(buf);
+        }
+        Ok(())
+    })
 }
