@@ -114,7 +114,7 @@ fn bench_foraging(c: &mut Criterion) {
             .iter()
             .map(|x| x.stats.states)
             .collect::<Vec<_>>(),
-        mono.target.state_count(),
+        mono.target_stats.states,
         s.local_modular_validation
             .as_ref()
             .is_some_and(|v| v.passed()),

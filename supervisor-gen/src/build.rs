@@ -29,6 +29,8 @@ pub struct BuildRequest {
     pub raw_weights: bool,
     /// Keep plant probability factors (`--thesis-literal-probabilities`).
     pub thesis_literal_probabilities: bool,
+    /// Keep each K = G ∥ E in the synthesis ([`SynthesisOptions::keep_targets`]), for drawings.
+    pub keep_targets: bool,
 }
 
 /// A successful build.
@@ -129,6 +131,7 @@ pub fn synthesise(request: &BuildRequest) -> Result<Synthesised, BuildError> {
         SynthesisOptions {
             raw_weights: request.raw_weights,
             thesis_literal_probabilities: request.thesis_literal_probabilities,
+            keep_targets: request.keep_targets,
             ..SynthesisOptions::default()
         },
     )?;
@@ -155,6 +158,7 @@ mod tests {
             architecture: Architecture::LocalModular,
             raw_weights: false,
             thesis_literal_probabilities: false,
+            keep_targets: false,
         }
     }
 

@@ -320,27 +320,28 @@ fn draw(args: &DrawArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// The build request of a project's arguments.
-fn request(args: &ProjectArgs) -> BuildRequest {
+/// The build request of a project's arguments; `keep_targets` keeps each K for the drawings.
+fn request(args: &ProjectArgs, keep_targets: bool) -> BuildRequest {
     BuildRequest {
         plants: args.plants.clone(),
         specs: args.specs.clone(),
         architecture: args.mode.into(),
         raw_weights: args.raw_weights,
         thesis_literal_probabilities: args.thesis_literal_probabilities,
+        keep_targets,
     }
 }
 
 /// Builds a project; `None` (with every diagnostic or the reason printed) if the input is invalid, the
 /// specification impossible or the result too large to compile. I/O problems are errors.
 fn built(args: &ProjectArgs) -> Result<Option<Built>> {
-    accepted(build(&request(args)), |built| &built.warnings)
+    accepted(build(&request(args, false)), |built| &built.warnings)
 }
 
 /// Synthesises a project without compiling it; `None` (with every diagnostic or the reason printed) if the input
 /// is invalid or the specification impossible. I/O problems are errors.
-fn synthesised(args: &ProjectArgs) -> Result<Option<Synthesised>> {
-    accepted(synthesise(&request(args)), |synthesised| {
+fn synthesised(args: &ProjectArgs, keep_targets: bool) -> Result<Option<Synthesised>> {
+    accepted(synthesise(&request(args, keep_targets)), |synthesised| {
         &synthesised.warnings
     })
 }
@@ -398,7 +399,7 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
     let Some(Synthesised {
         synthesis,
         warnings,
-    }) = synthesised(&args.project)?
+    }) = synthesised(&args.project, args.draw)?
     else {
         return Ok(Outcome::Rejected);
     };
@@ -710,17 +711,21 @@ fn draw_stages(
         })
         .collect();
     let none = HashMap::new();
-    let stages = [
-        ("1_G", &s.plant, &none),
-        ("2_E", &s.spec, &none),
-        ("3_K", &s.target, &removed),
-        ("4_supc", &s.unminimised, &none),
-    ];
+    // K is kept only when drawing (`keep_targets`).
+    let target = s.target.as_ref().map(|k| ("3_K", k, &removed));
+    let inputs = [("1_G", &s.plant, &none), ("2_E", &s.spec, &none)];
+    let supc = ("4_supc", &s.unminimised, &none);
     let minimised = reduction.map(|_| ("5_minimised", &s.supervisor, &none));
     let reduced = reduction
         .and_then(|r| r.reduced.as_ref())
         .map(|a| ("6_reduced", a, &none));
-    for (stage, automaton, marks) in stages.into_iter().chain(minimised).chain(reduced) {
+    let stages = inputs
+        .into_iter()
+        .chain(target)
+        .chain([supc])
+        .chain(minimised)
+        .chain(reduced);
+    for (stage, automaton, marks) in stages {
         drawer.draw(
             &format!("stages/{stem}_{stage}"),
             automaton,

@@ -28,6 +28,9 @@ pub struct SynthesisOptions {
     /// In local-modular mode, also synthesise the monolithic supervisor and validate against it (section 12,
     /// step 5). Default `true`; turning it off avoids the monolithic product for very large projects.
     pub validate: bool,
+    /// Keep each K = G ∥ E in [`SupervisorSynthesis::target`] (drawings need it). Default `true`; without it K
+    /// is dropped once SupC is done, before minimisation, which is where a large synthesis peaks in memory.
+    pub keep_targets: bool,
 }
 
 impl Default for SynthesisOptions {
@@ -36,6 +39,7 @@ impl Default for SynthesisOptions {
             raw_weights: false,
             thesis_literal_probabilities: false,
             validate: true,
+            keep_targets: true,
         }
     }
 }
@@ -77,9 +81,11 @@ pub struct SupervisorSynthesis {
     pub plant: Automaton,
     /// E: the specification (Emon, or E_i).
     pub spec: Automaton,
-    /// K = G ∥ E.
-    pub target: Automaton,
-    /// Every state of K removed by SupC, with its reason (ids refer to `target`).
+    /// K = G ∥ E, unless [`SynthesisOptions::keep_targets`] was off.
+    pub target: Option<Automaton>,
+    /// Statistics of K.
+    pub target_stats: SupervisorStats,
+    /// Every state of K removed by SupC, with its reason (ids refer to K).
     pub removed: Vec<RemovedState>,
     /// Number of SupC rounds.
     pub rounds: u32,
@@ -182,6 +188,7 @@ pub fn synthesize(
                         gmon.clone(),
                         e.clone(),
                         false,
+                        options.keep_targets,
                     ))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
@@ -207,6 +214,7 @@ pub fn synthesize(
                         g,
                         e.clone(),
                         false,
+                        options.keep_targets,
                     ))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
@@ -263,6 +271,7 @@ fn monolithic_unchecked(
         g,
         e,
         !options.raw_weights,
+        options.keep_targets,
     )
 }
 
@@ -287,6 +296,7 @@ fn one(
     g: Automaton,
     e: Automaton,
     renormalise: bool,
+    keep_target: bool,
 ) -> (SupervisorSynthesis, Option<String>) {
     let k = product_with_tuples(
         &format!("K_{}", name.trim_start_matches("S_")),
@@ -299,6 +309,8 @@ fn one(
     let result = supc(&target, &g, &g_of, events);
     debug!(supervisor = %name, k_states = target.state_count(), removed = result.removed.len(), rounds = result.rounds, "SupC");
     let empty = result.empty_reason(&target, events);
+    let target_stats = SupervisorStats::of(&target, events);
+    let target = keep_target.then_some(target);
     let mut unminimised = result.supervisor;
     unminimised.set_name(name.clone());
     unminimised.set_kind(ModelKind::Supervisor);
@@ -317,6 +329,7 @@ fn one(
             plant: g,
             spec: e,
             target,
+            target_stats,
             removed: result.removed,
             rounds: result.rounds,
             unminimised,

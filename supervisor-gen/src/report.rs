@@ -440,10 +440,10 @@ fn supervisor_report(s: &SupervisorSynthesis, file: &str, events: &EventTable) -
     let mut removed_non_coaccessible = Vec::new();
     for r in &s.removed {
         match r.reason {
-            RemovalReason::Bad { event, target } => removed_bad.push(RemovedBad {
+            RemovalReason::Bad { event, .. } => removed_bad.push(RemovedBad {
                 state: r.name.clone(),
                 event: events.name(event).to_owned(),
-                leads_to: target.map(|t| s.target.state_name(t).to_owned()),
+                leads_to: r.leads_to.clone(),
                 round: r.round,
             }),
             RemovalReason::Inaccessible => removed_unreachable.push(RemovedOther {
@@ -474,8 +474,8 @@ fn supervisor_report(s: &SupervisorSynthesis, file: &str, events: &EventTable) -
             transitions: s.stats_unminimised.transitions,
         },
         target: Counts {
-            states: s.target.state_count(),
-            transitions: s.target.transition_count(),
+            states: s.target_stats.states,
+            transitions: s.target_stats.transitions,
         },
         supc_rounds: s.rounds,
         removed_bad,

@@ -37,6 +37,8 @@ pub struct RemovedState {
     pub name: String,
     /// Why it was removed.
     pub reason: RemovalReason,
+    /// For a bad state whose uncontrollable event leads to a removed state, that state's name in K.
+    pub leads_to: Option<String>,
     /// The SupC round (from 1) in which it was removed.
     pub round: u32,
 }
@@ -100,10 +102,17 @@ pub fn supc(k: &Automaton, g: &Automaton, g_of: &[StateId], events: &EventTable)
     let mut records: Vec<RemovedState> = Vec::new();
     let mut work: Vec<StateId> = Vec::new();
     let record = |records: &mut Vec<RemovedState>, x: StateId, reason, round| {
+        let leads_to = match reason {
+            RemovalReason::Bad {
+                target: Some(t), ..
+            } => Some(k.state_name(t).to_owned()),
+            _ => None,
+        };
         records.push(RemovedState {
             state: x,
             name: k.state_name(x).to_owned(),
             reason,
+            leads_to,
             round,
         });
     };

@@ -23,6 +23,7 @@ fn synthesise(task: &str, plants: &[&str]) -> Built {
         architecture: Architecture::LocalModular,
         raw_weights: false,
         thesis_literal_probabilities: false,
+        keep_targets: false,
     })
     .expect("the models synthesise")
 }

@@ -207,6 +207,7 @@ fn compiled_file_written_by_the_toolchain_loads_as_the_same_set_as_the_model_fol
             architecture: Architecture::LocalModular,
             raw_weights: false,
             thesis_literal_probabilities: false,
+            keep_targets: false,
         },
     )
     .unwrap();

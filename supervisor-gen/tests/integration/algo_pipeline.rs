@@ -76,7 +76,7 @@ fn raw_weights_are_kept_through_synthesis() {
         ..SynthesisOptions::default()
     };
     let s = synthesize(&project_with(0.5), Architecture::Monolithic, raw).unwrap();
-    let k = &s.supervisors[0].target;
+    let k = s.supervisors[0].target.as_ref().expect("kept by default");
     assert_eq!(initial_labels(k), vec![(3.0, 0), (0.5, 4)]);
     // No renormalisation either: the surviving weight is stored as given.
     assert_eq!(initial_labels(&s.supervisors[0].supervisor), vec![(0.5, 4)]);
@@ -88,7 +88,7 @@ fn a5_plant_factors_count_only_with_thesis_literal_probabilities() {
     let default = synthesize(&p, Architecture::LocalModular, SynthesisOptions::default()).unwrap();
     // K at the initial state: a = 1 × 3/4, b = 1 × 1/4 (plant factors are 1).
     assert_eq!(
-        initial_labels(&default.supervisors[0].target),
+        initial_labels(default.supervisors[0].target.as_ref().expect("kept")),
         vec![(0.75, 0), (0.25, 4)]
     );
     let literal = SynthesisOptions {
@@ -98,7 +98,7 @@ fn a5_plant_factors_count_only_with_thesis_literal_probabilities() {
     let s = synthesize(&p, Architecture::LocalModular, literal).unwrap();
     // The plant's two controllable transitions at g0 get 1/2 each, multiplied into the product.
     assert_eq!(
-        initial_labels(&s.supervisors[0].target),
+        initial_labels(s.supervisors[0].target.as_ref().expect("kept")),
         vec![(0.375, 0), (0.125, 4)]
     );
 }

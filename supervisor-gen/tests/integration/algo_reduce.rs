@@ -381,6 +381,7 @@ fn a_timed_event_keeps_the_fixture_factory_at_four_states() {
         architecture: Architecture::LocalModular,
         raw_weights: false,
         thesis_literal_probabilities: false,
+        keep_targets: false,
     })
     .expect("synthesises");
     let synthesis = synthesised.synthesis;

@@ -61,7 +61,7 @@ fn small_factory_supervisor_prevents_buffer_overflow_with_six_states_and_eight_t
         (4, 8)
     );
     assert_eq!(
-        (sup.target.state_count(), sup.target.transition_count()),
+        (sup.target_stats.states, sup.target_stats.transitions),
         (8, 12)
     );
     // ((W,I),full) and ((W,W),full) are bad: finish1 would overflow the buffer.
