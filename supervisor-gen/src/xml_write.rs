@@ -148,6 +148,12 @@ impl ProbTexts {
     }
 }
 
+/// The writer's ends of one formatter's channels: blocks it filled, and buffers handed back for reuse.
+struct Formatter {
+    filled: Receiver<Vec<u8>>,
+    spare: SyncSender<Vec<u8>>,
+}
+
 /// Formats every state of `automaton` with `line` into blocks on [`FORMATTERS`] threads and writes the blocks to
 /// `out` in state order.
 fn write_blocks<F>(automaton: &Automaton, out: &mut impl Write, line: F) -> io::Result<()>
@@ -159,7 +165,7 @@ where
     let block =
         |b: usize| -> Range<usize> { b * STATES_PER_BLOCK..((b + 1) * STATES_PER_BLOCK).min(n) };
     std::thread::scope(|scope| {
-        let mut channels: Vec<(Receiver<Vec<u8>>, SyncSender<Vec<u8>>)> = Vec::new();
+        let mut formatters = Vec::with_capacity(FORMATTERS);
         for worker in 0..FORMATTERS {
             let (full_tx, full_rx) = sync_channel::<Vec<u8>>(2);
             let (empty_tx, empty_rx) = sync_channel::<Vec<u8>>(4);
@@ -178,14 +184,20 @@ where
                     }
                 }
             });
-            channels.push((full_rx, empty_tx));
+            formatters.push(Formatter {
+                filled: full_rx,
+                spare: empty_tx,
+            });
         }
         for b in 0..blocks {
-            let (full, empty) = &channels[b % FORMATTERS];
-            let buf = full.recv().expect("a formatter sends each of its blocks");
+            let formatter = &formatters[b % FORMATTERS];
+            let buf = formatter
+                .filled
+                .recv()
+                .expect("a formatter sends each of its blocks");
             out.write_all(&buf)?;
             // A formatter that has finished no longer takes buffers back.
-            let _ = empty.try_send(buf);
+            let _ = formatter.spare.try_send(buf);
         }
         Ok(())
     })
