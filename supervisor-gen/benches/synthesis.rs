@@ -2,15 +2,19 @@
 //! - transfer lines (n machines, n-1 buffers of capacity c): K = G ∥ E throughput and SupC time up to ~10^6 states,
 //!   minimisation and the whole monolithic pipeline below that;
 //! - n-robot mutual exclusion: the 2^n-state plant product (2^20 ≈ 10^6 states) and monolithic synthesis;
-//! - a foraging-sized local-modular project (8 plants, 7 specifications) with the monolithic validation.
+//! - a foraging-sized local-modular project (8 plants, 7 specifications) with the monolithic validation;
+//! - every task's model set under `configs/` (a folder with `G*.xml` plants and `E*.xml` specifications), loaded,
+//!   validated and synthesised local-modular as robots do.
 //!
 //! Model sizes are printed to stderr once per family so results can be read as states per second.
 
 use std::hint::black_box;
+use std::path::{Path, PathBuf};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use supervisor_gen::architecture::Architecture;
 use supervisor_gen::automaton::{Automaton, ModelKind, Project, StateId};
+use supervisor_gen::build::{BuildRequest, synthesise};
 use supervisor_gen::families::{foraging_like, mutex, transfer_line};
 use supervisor_gen::minimise::minimise;
 use supervisor_gen::pipeline::{SynthesisOptions, synthesize};
@@ -144,5 +148,80 @@ fn bench_foraging(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_transfer_line, bench_mutex, bench_foraging);
+/// Every folder under `dir` (itself included) that holds `G*.xml` plants and `E*.xml` specifications, sorted.
+fn model_sets(dir: &Path, sets: &mut Vec<(PathBuf, Vec<PathBuf>, Vec<PathBuf>)>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    let named = |prefix: &str| -> Vec<PathBuf> {
+        paths
+            .iter()
+            .filter(|p| {
+                let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+                name.starts_with(prefix) && name.ends_with(".xml")
+            })
+            .cloned()
+            .collect()
+    };
+    let (plants, specs) = (named("G"), named("E"));
+    if !plants.is_empty() && !specs.is_empty() {
+        sets.push((dir.to_path_buf(), plants, specs));
+    }
+    for sub in paths.iter().filter(|p| p.is_dir()) {
+        model_sets(sub, sets);
+    }
+}
+
+fn bench_task_models(c: &mut Criterion) {
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+    let mut sets = Vec::new();
+    for task in std::fs::read_dir(&configs).expect("configs/ is readable") {
+        let models = task.expect("a configs/ entry").path().join("models");
+        model_sets(&models, &mut sets);
+    }
+    sets.sort();
+    let mut group = c.benchmark_group("task_models");
+    group.sample_size(20);
+    for (dir, plants, specs) in sets {
+        let name = dir
+            .strip_prefix(&configs)
+            .unwrap_or(&dir)
+            .display()
+            .to_string();
+        let request = BuildRequest {
+            plants,
+            specs,
+            architecture: Architecture::LocalModular,
+            raw_weights: false,
+            thesis_literal_probabilities: false,
+            keep_targets: false,
+        };
+        let states: Vec<usize> = synthesise(&request)
+            .expect("every task's models synthesise")
+            .synthesis
+            .supervisors
+            .iter()
+            .map(|s| s.stats.states)
+            .collect();
+        eprintln!("{name}: local supervisors of {states:?} states");
+        group.bench_function(BenchmarkId::new("load_validate_synthesise", &name), |b| {
+            b.iter(|| {
+                black_box(synthesise(&request))
+                    .map(|s| s.synthesis.mem_cons)
+                    .ok()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_transfer_line,
+    bench_mutex,
+    bench_foraging,
+    bench_task_models
+);
 criterion_main!(benches);

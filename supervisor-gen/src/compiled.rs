@@ -373,7 +373,11 @@ impl SupervisorSet {
     /// Compiles synthesised supervisors over a project's event table, enforcing the limits of V15.
     ///
     /// The initial state of each automaton becomes state 0; the other states keep their relative order.
-    pub fn from_supervisors(events: &EventTable, sups: &[Automaton]) -> Result<Self, CodegenError> {
+    pub fn from_supervisors<'a>(
+        events: &EventTable,
+        sups: impl IntoIterator<Item = &'a Automaton>,
+    ) -> Result<Self, CodegenError> {
+        let sups: Vec<&Automaton> = sups.into_iter().collect();
         if events.len() > MAX_EVENTS {
             return Err(CodegenError::TooManyEvents {
                 count: events.len(),
@@ -394,7 +398,7 @@ impl SupervisorSet {
             .collect::<Result<Vec<_>, CodegenError>>()?;
         let supervisors = sups
             .iter()
-            .map(|a| compile_supervisor(events, a))
+            .map(|&a| compile_supervisor(events, a))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             events: compiled_events,

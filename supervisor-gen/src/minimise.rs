@@ -23,12 +23,17 @@ use crate::trim::{accessible_mask, restrict};
 ///
 /// State names are those of each class's first state; the initial state's class becomes state 0.
 pub fn minimise(a: &Automaton) -> Automaton {
-    let a = accessible_part(a);
+    minimise_accessible(&accessible_part(a))
+}
+
+/// [`minimise`] of an automaton whose states are all accessible, as SupC's result is: it skips the reachability
+/// pass (an inaccessible state would be kept, in a class of its own or merged with its equals).
+pub fn minimise_accessible(a: &Automaton) -> Automaton {
     let n = a.state_count();
     if n == 0 {
-        return a.into_owned();
+        return a.clone();
     }
-    let incoming = Incoming::new(&a);
+    let incoming = Incoming::new(a);
     let mut blocks = Partition::new(n);
     for x in 0..n {
         if a.is_marked(StateId(x as u32)) {
@@ -55,7 +60,7 @@ pub fn minimise(a: &Automaton) -> Automaton {
     }
     let mut class: Vec<u32> = blocks.places.iter().map(|p| p.set & !ALONE).collect();
     let classes = renumber(&mut class);
-    quotient(&a, &class, classes)
+    quotient(a, &class, classes)
 }
 
 /// `a` itself when every state is accessible (as after SupC), else its accessible part.
@@ -91,14 +96,25 @@ impl Incoming {
         let mut fill = first.clone();
         let mut pairs = vec![(0u32, 0u32); m];
         let mut ids: HashMap<u64, u32> = HashMap::new();
+        // Most automata have a handful of labels: a small direct-mapped cache in front of the map.
+        let mut recent: [Option<(u64, u32)>; 64] = [None; 64];
         for x in a.states() {
             for t in a.transitions(x) {
                 let key = (u64::from(t.event.0) << 48)
                     | (u64::from(prob_to_q16(t.prob)) << 32)
                     | u64::from(t.lower_bound);
-                let next = ids.len() as u32;
+                let cached = &mut recent[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 58) as usize];
+                let letter = match *cached {
+                    Some((k, letter)) if k == key => letter,
+                    _ => {
+                        let next = ids.len() as u32;
+                        let letter = *ids.entry(key).or_insert(next);
+                        *cached = Some((key, letter));
+                        letter
+                    }
+                };
                 let slot = &mut fill[t.target.index()];
-                pairs[*slot as usize] = (x.0, *ids.entry(key).or_insert(next));
+                pairs[*slot as usize] = (x.0, letter);
                 *slot += 1;
             }
         }

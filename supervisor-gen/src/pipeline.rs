@@ -13,7 +13,7 @@ use crate::architecture::{
 };
 use crate::automaton::{Automaton, EventTable, ModelKind, Project, StateId};
 use crate::compiled::{CodegenError, SupervisorSet, mem_cons_of};
-use crate::minimise::minimise;
+use crate::minimise::minimise_accessible;
 use crate::normalise::{NormaliseOptions, ZeroWeights, normalise, normalise_project};
 use crate::product::{product, product_with_tuples};
 use crate::supc::{RemovedState, supc};
@@ -128,7 +128,10 @@ impl Synthesis {
 
     /// Compiles the final supervisors into the section 9 byte layout (fails on V15 limits).
     pub fn compile(&self) -> Result<SupervisorSet, CodegenError> {
-        SupervisorSet::from_supervisors(&self.normalised.events, &self.final_supervisors())
+        SupervisorSet::from_supervisors(
+            &self.normalised.events,
+            self.supervisors.iter().map(|s| &s.supervisor),
+        )
     }
 }
 
@@ -314,7 +317,8 @@ fn one(
     let mut unminimised = result.supervisor;
     unminimised.set_name(name.clone());
     unminimised.set_kind(ModelKind::Supervisor);
-    let mut supervisor = minimise(&unminimised);
+    // SupC's result has only accessible states.
+    let mut supervisor = minimise_accessible(&unminimised);
     if renormalise {
         // Zero-sum states (only possible with zero weights) are left for the runtime's uniform choice (5.2).
         normalise(&mut supervisor, events);

@@ -61,45 +61,58 @@ impl ReverseAdjacency {
 
 /// States reachable from the initial state through states not in `removed`.
 pub fn accessible_mask(a: &Automaton, removed: &[bool]) -> Vec<bool> {
-    let n = a.state_count();
-    let mut seen = vec![false; n];
-    if n == 0 || removed[a.initial().index()] {
-        return seen;
-    }
-    let mut stack = vec![a.initial()];
-    seen[a.initial().index()] = true;
-    while let Some(x) = stack.pop() {
-        for t in a.transitions(x) {
-            let y = t.target.index();
-            if !seen[y] && !removed[y] {
-                seen[y] = true;
-                stack.push(t.target);
-            }
+    let start = (a.state_count() > 0).then(|| a.initial().0);
+    search(removed, start, |x, next| {
+        for t in a.transitions(StateId(x)) {
+            next(t.target.0);
         }
-    }
-    seen
+    })
 }
 
 /// States from which a marked state is reachable through states not in `removed`.
 pub fn coaccessible_mask(a: &Automaton, rev: &ReverseAdjacency, removed: &[bool]) -> Vec<bool> {
-    let n = a.state_count();
-    let mut seen = vec![false; n];
-    let mut stack: Vec<StateId> = Vec::new();
-    for x in a.states() {
-        if a.is_marked(x) && !removed[x.index()] {
-            seen[x.index()] = true;
-            stack.push(x);
+    let marked = a.states().filter(|&x| a.is_marked(x)).map(|x| x.0);
+    search(removed, marked, |y, next| {
+        for (x, _) in rev.incoming(StateId(y)) {
+            next(x.0);
+        }
+    })
+}
+
+/// Breadth-first search from `starts` along `edges`, avoiding `removed`; returns the states found.
+///
+/// Products number their states breadth-first, so a breadth-first search reads the transitions nearly in order;
+/// one status byte per state makes each visited edge a single random access.
+fn search(
+    removed: &[bool],
+    starts: impl IntoIterator<Item = u32>,
+    edges: impl Fn(u32, &mut dyn FnMut(u32)),
+) -> Vec<bool> {
+    const OPEN: u8 = 0;
+    const FOUND: u8 = 1;
+    const CLOSED: u8 = 2;
+    let mut status: Vec<u8> = removed
+        .iter()
+        .map(|&r| if r { CLOSED } else { OPEN })
+        .collect();
+    let mut queue: Vec<u32> = Vec::new();
+    for x in starts {
+        if status[x as usize] == OPEN {
+            status[x as usize] = FOUND;
+            queue.push(x);
         }
     }
-    while let Some(y) = stack.pop() {
-        for (x, _) in rev.incoming(y) {
-            if !seen[x.index()] && !removed[x.index()] {
-                seen[x.index()] = true;
-                stack.push(x);
+    let mut head = 0;
+    while let Some(&x) = queue.get(head) {
+        head += 1;
+        edges(x, &mut |y| {
+            if status[y as usize] == OPEN {
+                status[y as usize] = FOUND;
+                queue.push(y);
             }
-        }
+        });
     }
-    seen
+    status.into_iter().map(|s| s == FOUND).collect()
 }
 
 /// The sub-automaton on the states where `keep` is true, renumbered in ascending old order, dropping transitions

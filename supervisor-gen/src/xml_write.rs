@@ -1,7 +1,8 @@
 //! Writer for the thesis XML format (docs/ptsct.md section 10.4): children in DTD order (states, events, transitions),
 //! canonical `1`/`0` flags, explicit `prob` and `time` on every controllable transition and neither on uncontrollable
-//! ones. Probabilities are written with the shortest text that reads back to the same `f64`, so reading a written
-//! file gives the same automaton.
+//! ones, except that a plant's `prob` is left out when it is 1, the default (a plant's weight is read only under
+//! the thesis-literal rule, and is warned about otherwise). Probabilities are written with the shortest text that
+//! reads back to the same `f64`, so reading a written file gives the same automaton.
 //!
 //! A synthesised supervisor can have millions of transitions (a gigabyte of XML), so the text is never held whole:
 //! two threads format alternate blocks of states into buffers while the caller's thread writes them out in order.
@@ -15,7 +16,7 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use quick_xml::escape::escape;
 
-use crate::automaton::{Automaton, EventTable, StateId};
+use crate::automaton::{Automaton, EventTable, ModelKind, StateId};
 
 /// States formatted into one buffer.
 const STATES_PER_BLOCK: usize = 4_096;
@@ -73,6 +74,7 @@ pub fn write_xml(
         )?;
     }
     out.write_all(b"  </events>\n  <transitions>\n")?;
+    let plant = automaton.kind() == ModelKind::Plant;
     let event_attrs: Vec<String> = events
         .ids()
         .map(|e| format!("\" event=\"{}\"", escape(events.name(e))))
@@ -85,9 +87,12 @@ pub fn write_xml(
             line.name(automaton, t.target);
             line.bytes(event_attrs[t.event.index()].as_bytes());
             if events.is_controllable(t.event) {
-                line.bytes(b" prob=\"");
-                line.bytes(probs.text(t.prob));
-                line.bytes(b"\" time=\"");
+                if !(plant && t.prob == 1.0) {
+                    line.bytes(b" prob=\"");
+                    line.bytes(probs.text(t.prob));
+                    line.bytes(b"\"");
+                }
+                line.bytes(b" time=\"");
                 line.number(t.lower_bound);
                 line.bytes(b"\"");
             }
@@ -201,4 +206,59 @@ where
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plant_leaves_out_only_the_default_weight() {
+        let mut events = EventTable::new();
+        let a = events.intern("a", true).unwrap();
+        let b = events.intern("b", true).unwrap();
+        let mut plant = Automaton::new("g", ModelKind::Plant);
+        let s = plant.add_state("s", true).unwrap();
+        plant.add_transition(s, a, s, 1.0, 2).unwrap();
+        plant.add_transition(s, b, s, 0.5, 0).unwrap();
+        let text = to_xml(&plant, &events);
+        assert!(text.contains(r#"event="a" time="2"/>"#), "{text}");
+        assert!(
+            text.contains(r#"event="b" prob="0.5" time="0"/>"#),
+            "{text}"
+        );
+        plant.set_kind(ModelKind::Supervisor);
+        let text = to_xml(&plant, &events);
+        assert!(text.contains(r#"event="a" prob="1" time="2"/>"#), "{text}");
+    }
+
+    /// Several blocks per formatter: states and transitions come out in state order, each once.
+    #[test]
+    fn blocks_formatted_on_several_threads_are_written_in_state_order() {
+        let mut events = EventTable::new();
+        let next = events.intern("next", true).unwrap();
+        let n = STATES_PER_BLOCK * (2 * FORMATTERS + 1) + 7;
+        let mut chain = Automaton::new("chain", ModelKind::Supervisor);
+        let states: Vec<StateId> = (0..n)
+            .map(|i| chain.add_state(format!("q{i}"), i == 0).unwrap())
+            .collect();
+        for w in states.windows(2) {
+            chain.add_transition(w[0], next, w[1], 1.0, 0).unwrap();
+        }
+        let text = to_xml(&chain, &events);
+        let names: Vec<&str> = text
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("<state name=\"q"))
+            .map(|l| &l[..l.find('"').unwrap()])
+            .collect();
+        let expected: Vec<String> = (0..n).map(|i| i.to_string()).collect();
+        assert_eq!(names, expected);
+        let sources: Vec<&str> = text
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("<transition src=\"q"))
+            .map(|l| &l[..l.find('"').unwrap()])
+            .collect();
+        assert_eq!(sources, expected[..n - 1]);
+        assert!(text.ends_with("  </transitions>\n</automata>\n"));
+    }
 }
