@@ -417,36 +417,45 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
     let out = &args.out;
     create_dir(out)?;
     let events = &synthesis.normalised.events;
-    let files = write_supervisors_xml(out, &synthesis, reduction.as_ref())?;
+    let (files, models) = supervisors_xml(&synthesis, reduction.as_ref());
     // A result is never lost: a set too large for the compiled format skips only the compiled outputs.
     let mut skipped = Vec::new();
     let (bytes_written, mem_cons) =
         write_compiled(args, &synthesis, reduction.as_ref(), &mut skipped)?;
-    if args.draw {
-        let dir = out.join("drawings");
-        create_dir(&dir)?;
-        let mut drawer = Drawer {
-            dir: &dir,
-            events,
-            images: args.images.images(),
-            skipped: Vec::new(),
-        };
-        draw_synthesis(&mut drawer, &synthesis, reduction.as_ref())?;
-        skipped.extend(drawer.skipped.into_iter().map(|s| SkippedOutput {
-            output: format!("drawings/{}", s.output),
-            ..s
-        }));
-    }
-    let mut report = Report::new(&synthesis, &files.supervisors, bytes_written, &warnings);
-    if let Some(r) = &reduction {
-        let files = ReductionFiles {
-            reduced: &files.reduced,
-            observers: &files.observers,
-        };
-        report = report.with_reduction(r, events, files, limits, bytes_written);
-    }
-    report.skipped = skipped;
-    write_with(&out.join("report.json"), |w| report.write_json(w))?;
+    // A large supervisor's XML is the bulk of the output: it is written while the rest is prepared.
+    let report = std::thread::scope(|scope| {
+        let xml = scope.spawn(|| write_models(out, &models, events));
+        let report = (|| -> Result<Report> {
+            if args.draw {
+                let dir = out.join("drawings");
+                create_dir(&dir)?;
+                let mut drawer = Drawer {
+                    dir: &dir,
+                    events,
+                    images: args.images.images(),
+                    skipped: Vec::new(),
+                };
+                draw_synthesis(&mut drawer, &synthesis, reduction.as_ref())?;
+                skipped.extend(drawer.skipped.into_iter().map(|s| SkippedOutput {
+                    output: format!("drawings/{}", s.output),
+                    ..s
+                }));
+            }
+            let mut report = Report::new(&synthesis, &files.supervisors, bytes_written, &warnings);
+            if let Some(r) = &reduction {
+                let files = ReductionFiles {
+                    reduced: &files.reduced,
+                    observers: &files.observers,
+                };
+                report = report.with_reduction(r, events, files, limits, bytes_written);
+            }
+            report.skipped = skipped;
+            write_with(&out.join("report.json"), |w| report.write_json(w))?;
+            Ok(report)
+        })();
+        xml.join().expect("writing the XML does not panic")?;
+        report
+    })?;
     print_summary(&synthesis, reduction.as_ref(), mem_cons, out);
     for s in &report.skipped {
         eprintln!("warning: {} not written: {}", s.output, s.reason);
@@ -454,7 +463,7 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// The XML files `synth` wrote, relative to the output directory.
+/// The XML files `synth` writes, relative to the output directory.
 struct XmlFiles {
     /// One per supervisor, the one compiled: `<S>.xml`.
     supervisors: Vec<String>,
@@ -464,41 +473,54 @@ struct XmlFiles {
     observers: Vec<String>,
 }
 
-/// Writes the supervisors (reduced where a reduction is used), every reduction and the observers as XML.
-fn write_supervisors_xml(
-    out: &Path,
-    synthesis: &Synthesis,
-    reduction: Option<&Reduction>,
-) -> Result<XmlFiles> {
-    let events = &synthesis.normalised.events;
-    let Some(r) = reduction else {
-        return Ok(XmlFiles {
-            supervisors: write_models(
-                out,
-                synthesis.supervisors.iter().map(|s| &s.supervisor),
+/// The supervisors (reduced where a reduction is used), every reduction and the observers, each with its file.
+fn supervisors_xml<'a>(
+    synthesis: &'a Synthesis,
+    reduction: Option<&'a Reduction>,
+) -> (XmlFiles, Vec<(String, &'a Automaton)>) {
+    let mut models = Vec::new();
+    let mut named = |automata: Vec<&'a Automaton>, prefix: &str, suffix: &str| -> Vec<String> {
+        automata
+            .into_iter()
+            .map(|a| {
+                let file = format!("{prefix}{}{suffix}.xml", dot::file_stem(a.name()));
+                models.push((file.clone(), a));
+                file
+            })
+            .collect()
+    };
+    let files = match reduction {
+        None => XmlFiles {
+            supervisors: named(
+                synthesis
+                    .supervisors
+                    .iter()
+                    .map(|s| &s.supervisor)
+                    .collect(),
                 "",
                 "",
-                events,
-            )?,
+            ),
             reduced: Vec::new(),
             observers: Vec::new(),
-        });
+        },
+        Some(r) => XmlFiles {
+            supervisors: named(
+                r.supervisors.iter().map(|s| s.supervisor()).collect(),
+                "",
+                "",
+            ),
+            reduced: named(
+                r.supervisors
+                    .iter()
+                    .filter_map(|s| s.reduced.as_ref())
+                    .collect(),
+                "",
+                ".reduced",
+            ),
+            observers: named(r.observers.iter().collect(), "observer_", ""),
+        },
     };
-    let finals: Vec<Automaton> = r
-        .supervisors
-        .iter()
-        .map(|s| s.supervisor().clone())
-        .collect();
-    let reduced: Vec<Automaton> = r
-        .supervisors
-        .iter()
-        .filter_map(|s| s.reduced.clone())
-        .collect();
-    Ok(XmlFiles {
-        supervisors: write_models(out, &finals, "", "", events)?,
-        reduced: write_models(out, &reduced, "", ".reduced", events)?,
-        observers: write_models(out, &r.observers, "observer_", "", events)?,
-    })
+    (files, models)
 }
 
 /// Writes `supervisors.ptsct` and `supervisors.rs` of the set (the reduced one with `--reduce`), or notes in
@@ -539,21 +561,12 @@ fn write_compiled(
     }
 }
 
-/// Writes each automaton as `<prefix><name><suffix>.xml` in `out`; returns the file names.
-fn write_models<'a>(
-    out: &Path,
-    automata: impl IntoIterator<Item = &'a Automaton>,
-    prefix: &str,
-    suffix: &str,
-    events: &EventTable,
-) -> Result<Vec<String>> {
-    let mut files = Vec::new();
-    for a in automata {
-        let file = format!("{prefix}{}{suffix}.xml", dot::file_stem(a.name()));
-        write_with(&out.join(&file), |w| write_xml(a, events, w))?;
-        files.push(file);
+/// Writes each automaton to its file in `out`.
+fn write_models(out: &Path, models: &[(String, &Automaton)], events: &EventTable) -> Result<()> {
+    for (file, a) in models {
+        write_with(&out.join(file), |w| write_xml(a, events, w))?;
     }
-    Ok(files)
+    Ok(())
 }
 
 /// A one-line description of the inputs for the generated module's header.
