@@ -317,6 +317,7 @@ fn one(
     let mut unminimised = result.supervisor;
     unminimised.set_name(name.clone());
     unminimised.set_kind(ModelKind::Supervisor);
+    crate::progress::stage(|| format!("minimising {name} ({} states)", unminimised.state_count()));
     // SupC's result has only accessible states.
     let mut supervisor = minimise_accessible(&unminimised);
     if renormalise {

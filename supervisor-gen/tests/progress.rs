@@ -46,6 +46,7 @@ fn a_synthesis_reports_its_products_states_and_supc_rounds() {
         "stage product G_mon",
         "stage product E_mon",
         "stage SupC of",
+        "stage minimising S_mon",
     ] {
         assert!(
             lines.iter().any(|l| l.starts_with(stage)),
