@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::fmt;
 
 /// A global event id, an index into the project's [`EventTable`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct EventId(pub u16);
 
 impl EventId {

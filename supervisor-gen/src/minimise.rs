@@ -15,9 +15,9 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 
-use crate::automaton::{Automaton, StateId};
+use crate::automaton::{Automaton, StateId, Transition};
 use crate::compiled::prob_to_q16;
-use crate::trim::{accessible_mask, restrict};
+use crate::trim::{ReverseAdjacency, accessible_mask, restrict};
 
 /// The minimal automaton with the same language, marked language and P/T labels as `a`'s accessible part.
 ///
@@ -33,7 +33,8 @@ pub fn minimise_accessible(a: &Automaton) -> Automaton {
     if n == 0 {
         return a.clone();
     }
-    let incoming = Incoming::new(a);
+    let mut letters = Letters::new();
+    let incoming = ReverseAdjacency::labelled(a, |t| letters.of(t));
     let mut blocks = Partition::new(n);
     for x in 0..n {
         if a.is_marked(StateId(x as u32)) {
@@ -41,14 +42,14 @@ pub fn minimise_accessible(a: &Automaton) -> Automaton {
         }
     }
     blocks.split();
-    let mut buckets = Buckets::new(incoming.letters);
+    let mut buckets = Buckets::new(letters.count());
     let mut b = 0;
     while b < blocks.sets.len() {
         let range = blocks.sets[b];
         buckets.gather(
             blocks.elems[range.first as usize..range.past as usize]
                 .iter()
-                .flat_map(|&s| incoming.of(s)),
+                .flat_map(|&s| incoming.entering(s).iter().copied()),
         );
         for group in buckets.groups() {
             for &p in group {
@@ -73,62 +74,40 @@ fn accessible_part(a: &Automaton) -> Cow<'_, Automaton> {
     }
 }
 
-/// Incoming transitions of every state as (source, letter) pairs, letters being dense ids of the distinct labels.
-struct Incoming {
-    first: Vec<u32>,
-    pairs: Vec<(u32, u32)>,
-    letters: usize,
+/// Dense ids of the distinct labels (event, P in Q0.16, T) of an automaton's transitions, the letters the
+/// refinement splits by.
+struct Letters {
+    ids: HashMap<u64, u32>,
+    /// Most automata have a handful of labels: a small direct-mapped cache in front of the map.
+    recent: [Option<(u64, u32)>; 64],
 }
 
-impl Incoming {
-    fn new(a: &Automaton) -> Self {
-        let n = a.state_count();
-        let mut first = vec![0u32; n + 1];
-        for x in a.states() {
-            for t in a.transitions(x) {
-                first[t.target.index() + 1] += 1;
-            }
-        }
-        for i in 0..n {
-            first[i + 1] += first[i];
-        }
-        let m = first[n] as usize;
-        let mut fill = first.clone();
-        let mut pairs = vec![(0u32, 0u32); m];
-        let mut ids: HashMap<u64, u32> = HashMap::new();
-        // Most automata have a handful of labels: a small direct-mapped cache in front of the map.
-        let mut recent: [Option<(u64, u32)>; 64] = [None; 64];
-        for x in a.states() {
-            for t in a.transitions(x) {
-                let key = (u64::from(t.event.0) << 48)
-                    | (u64::from(prob_to_q16(t.prob)) << 32)
-                    | u64::from(t.lower_bound);
-                let cached = &mut recent[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 58) as usize];
-                let letter = match *cached {
-                    Some((k, letter)) if k == key => letter,
-                    _ => {
-                        let next = ids.len() as u32;
-                        let letter = *ids.entry(key).or_insert(next);
-                        *cached = Some((key, letter));
-                        letter
-                    }
-                };
-                let slot = &mut fill[t.target.index()];
-                pairs[*slot as usize] = (x.0, letter);
-                *slot += 1;
-            }
-        }
+impl Letters {
+    fn new() -> Self {
         Self {
-            first,
-            pairs,
-            letters: ids.len(),
+            ids: HashMap::new(),
+            recent: [None; 64],
         }
     }
 
-    /// The (source, letter) pairs of the transitions entering `y`.
-    fn of(&self, y: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
-        let range = self.first[y as usize] as usize..self.first[y as usize + 1] as usize;
-        self.pairs[range].iter().copied()
+    fn of(&mut self, t: &Transition) -> u32 {
+        let key = (u64::from(t.event.0) << 48)
+            | (u64::from(prob_to_q16(t.prob)) << 32)
+            | u64::from(t.lower_bound);
+        let cached = &mut self.recent[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 58) as usize];
+        match *cached {
+            Some((k, letter)) if k == key => letter,
+            _ => {
+                let next = self.ids.len() as u32;
+                let letter = *self.ids.entry(key).or_insert(next);
+                *cached = Some((key, letter));
+                letter
+            }
+        }
+    }
+
+    fn count(&self) -> usize {
+        self.ids.len()
     }
 }
 

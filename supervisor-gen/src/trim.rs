@@ -3,20 +3,33 @@
 //! Reachability runs over a `removed` mask so SupC can re-run it every round without rebuilding graphs; the
 //! worklists and the reverse adjacency are flat `Vec`s sized once per automaton.
 
-use crate::automaton::{Automaton, EventId, StateId};
+use crate::automaton::{Automaton, EventId, StateId, Transition};
 
-/// Incoming transitions of every state in compressed form: the predecessors of `y` are
-/// `sources[offsets[y]..offsets[y + 1]]`, labelled by the same range of `events`.
+/// Incoming transitions of every state in compressed form: the transitions entering `y` are
+/// `pairs[offsets[y]..offsets[y + 1]]`, each as (source, label). The label is the event unless built with
+/// [`ReverseAdjacency::labelled`].
 #[derive(Debug, Clone)]
-pub struct ReverseAdjacency {
+pub struct ReverseAdjacency<L = EventId> {
     offsets: Vec<u32>,
-    sources: Vec<u32>,
-    events: Vec<EventId>,
+    pairs: Vec<(u32, L)>,
 }
 
 impl ReverseAdjacency {
-    /// Builds the reverse adjacency of `a` in two linear passes.
+    /// Builds the reverse adjacency of `a`, labelled by events.
     pub fn new(a: &Automaton) -> Self {
+        Self::labelled(a, |t| t.event)
+    }
+
+    /// The (source, event) pairs of the transitions entering `y`.
+    pub fn incoming(&self, y: StateId) -> impl Iterator<Item = (StateId, EventId)> + '_ {
+        self.entering(y.0).iter().map(|&(s, e)| (StateId(s), e))
+    }
+}
+
+impl<L: Copy + Default> ReverseAdjacency<L> {
+    /// Builds the reverse adjacency of `a` in two linear passes, labelling each transition by `label`, which is
+    /// called once per transition in source order.
+    pub fn labelled(a: &Automaton, mut label: impl FnMut(&Transition) -> L) -> Self {
         let n = a.state_count();
         let mut offsets = vec![0u32; n + 1];
         for x in a.states() {
@@ -29,33 +42,20 @@ impl ReverseAdjacency {
         }
         let m = offsets[n] as usize;
         let mut fill = offsets.clone();
-        let mut sources = vec![0u32; m];
-        let mut events = vec![EventId(0); m];
+        let mut pairs = vec![(0u32, L::default()); m];
         for x in a.states() {
             for t in a.transitions(x) {
                 let slot = &mut fill[t.target.index()];
-                sources[*slot as usize] = x.0;
-                events[*slot as usize] = t.event;
+                pairs[*slot as usize] = (x.0, label(t));
                 *slot += 1;
             }
         }
-        Self {
-            offsets,
-            sources,
-            events,
-        }
+        Self { offsets, pairs }
     }
 
-    /// The (source, event) pairs of the transitions entering `y`.
-    pub fn incoming(&self, y: StateId) -> impl Iterator<Item = (StateId, EventId)> + '_ {
-        let (lo, hi) = (
-            self.offsets[y.index()] as usize,
-            self.offsets[y.index() + 1] as usize,
-        );
-        self.sources[lo..hi]
-            .iter()
-            .zip(&self.events[lo..hi])
-            .map(|(&s, &e)| (StateId(s), e))
+    /// The (source, label) pairs of the transitions entering state `y`.
+    pub fn entering(&self, y: u32) -> &[(u32, L)] {
+        &self.pairs[self.offsets[y as usize] as usize..self.offsets[y as usize + 1] as usize]
     }
 }
 
