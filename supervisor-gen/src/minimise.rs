@@ -35,8 +35,14 @@ pub fn minimise_accessible(a: &Automaton) -> Automaton {
         return a.clone();
     }
     let mut letters = Letters::new();
-    let incoming = ReverseAdjacency::labelled(a, |t| letters.of(t));
-    let (signature, signatures) = signatures(a, &mut letters);
+    let letter: Vec<u32> = a
+        .states()
+        .flat_map(|x| a.transitions(x))
+        .map(|t| letters.of(t))
+        .collect();
+    let incoming = ReverseAdjacency::labelled(a, |i, _| letter[i]);
+    let (signature, signatures) = signatures(a, &letter);
+    drop(letter);
     let mut blocks = Partition::of_classes(&signature, signatures);
     let mut buckets = Buckets::new(letters.count());
     let mut b = 0;
@@ -72,33 +78,33 @@ fn accessible_part(a: &Automaton) -> Cow<'_, Automaton> {
 
 /// Each state's signature id: states with the same marking and the same outgoing letters share one, in order
 /// of first appearance. States that differ in either are never equivalent, so refinement may start from these
-/// classes instead of {marked, unmarked}; it then has far fewer splits left to do. Returns the ids and their count.
-fn signatures(a: &Automaton, letters: &mut Letters) -> (Vec<u32>, usize) {
+/// classes instead of {marked, unmarked}; it then has far fewer splits left to do. `letter` holds every
+/// transition's letter in source order. Returns the ids and their count.
+fn signatures(a: &Automaton, letter: &[u32]) -> (Vec<u32>, usize) {
     let mut ids: Vec<u32> = Vec::with_capacity(a.state_count());
     // Signature hash -> (id, a state that has it), checked letter by letter against that state.
-    let mut seen: HashMap<u64, Vec<(u32, u32)>> = HashMap::new();
+    let mut seen: HashMap<u64, Vec<(u32, StateId)>> = HashMap::new();
     let mut count = 0u32;
-    let mut mine: Vec<u32> = Vec::new();
-    let mut theirs: Vec<u32> = Vec::new();
+    let mut first = vec![0usize; a.state_count() + 1];
     for x in a.states() {
-        mine.clear();
-        mine.extend(a.transitions(x).iter().map(|t| letters.of(t)));
+        first[x.index() + 1] = first[x.index()] + a.transitions(x).len();
+    }
+    let letters_of = |x: StateId| &letter[first[x.index()]..first[x.index() + 1]];
+    for x in a.states() {
+        let mine = letters_of(x);
         let mut h = u64::from(a.is_marked(x)) ^ 0x9E37_79B9_7F4A_7C15;
-        for &l in &mine {
+        for &l in mine {
             h = (h ^ u64::from(l)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
             h ^= h >> 29;
         }
         let candidates = seen.entry(h).or_default();
-        let found = candidates.iter().find(|&&(_, rep)| {
-            let rep = StateId(rep);
-            theirs.clear();
-            theirs.extend(a.transitions(rep).iter().map(|t| letters.of(t)));
-            a.is_marked(rep) == a.is_marked(x) && theirs == mine
-        });
+        let found = candidates
+            .iter()
+            .find(|&&(_, rep)| a.is_marked(rep) == a.is_marked(x) && letters_of(rep) == mine);
         let id = match found {
             Some(&(id, _)) => id,
             None => {
-                candidates.push((count, x.0));
+                candidates.push((count, x));
                 count += 1;
                 count - 1
             }

@@ -17,7 +17,7 @@ pub struct ReverseAdjacency<L = EventId> {
 impl ReverseAdjacency {
     /// Builds the reverse adjacency of `a`, labelled by events.
     pub fn new(a: &Automaton) -> Self {
-        Self::labelled(a, |t| t.event)
+        Self::labelled(a, |_, t| t.event)
     }
 
     /// The (source, event) pairs of the transitions entering `y`.
@@ -28,8 +28,8 @@ impl ReverseAdjacency {
 
 impl<L: Copy + Default> ReverseAdjacency<L> {
     /// Builds the reverse adjacency of `a` in two linear passes, labelling each transition by `label`, which is
-    /// called once per transition in source order.
-    pub fn labelled(a: &Automaton, mut label: impl FnMut(&Transition) -> L) -> Self {
+    /// given the transition's number in source order (0 for the first transition of state 0) and the transition.
+    pub fn labelled(a: &Automaton, label: impl Fn(usize, &Transition) -> L) -> Self {
         let n = a.state_count();
         let mut offsets = vec![0u32; n + 1];
         for x in a.states() {
@@ -43,12 +43,13 @@ impl<L: Copy + Default> ReverseAdjacency<L> {
         let m = offsets[n] as usize;
         let mut fill = offsets.clone();
         let mut pairs = vec![(0u32, L::default()); m];
-        for x in a.states() {
-            for t in a.transitions(x) {
-                let slot = &mut fill[t.target.index()];
-                pairs[*slot as usize] = (x.0, label(t));
-                *slot += 1;
-            }
+        let from = a
+            .states()
+            .flat_map(|x| a.transitions(x).iter().map(move |t| (x, t)));
+        for (i, (x, t)) in from.enumerate() {
+            let slot = &mut fill[t.target.index()];
+            pairs[*slot as usize] = (x.0, label(i, t));
+            *slot += 1;
         }
         Self { offsets, pairs }
     }
