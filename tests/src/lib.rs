@@ -646,11 +646,44 @@ pub fn with_faults(dir: &Path, config: &str, faults: &str) -> String {
     })
 }
 
-/// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte.
+/// The bytes of the file `name` of the run folder `dir`. A record table's CSV name (`trajectory.csv`,
+/// `events.csv`, `messages.csv`) gives its CSV text also when the run left the table as Parquet (the default): the
+/// Parquet file is converted back with `swarm export`'s code in a temporary folder, which gives the world's CSV
+/// byte for byte. The CSV file is read while it exists (a live run, or `--records csv`).
+pub fn run_file(dir: &Path, name: &str) -> Vec<u8> {
+    match std::fs::read(dir.join(name)) {
+        Ok(bytes) => return bytes,
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => panic!("{name}: {e}"),
+        Err(_) => {}
+    }
+    let Some(table) = swarm_records::Table::ALL
+        .into_iter()
+        .find(|t| t.csv_name() == name)
+    else {
+        panic!("{}: no such file", dir.join(name).display());
+    };
+    let parquet = dir.join(table.parquet_name());
+    let scratch = tempfile::tempdir().expect("a temporary directory");
+    match std::fs::copy(&parquet, scratch.path().join(table.parquet_name())) {
+        Ok(_) => {}
+        // The run converted its records between the two reads.
+        Err(_) if dir.join(name).exists() => return run_file(dir, name),
+        Err(e) => panic!("{name}: no such file, and {}: {e}", parquet.display()),
+    }
+    swarm_records::export(scratch.path(), swarm_records::Format::Csv)
+        .unwrap_or_else(|e| panic!("{} back to CSV: {e}", parquet.display()));
+    std::fs::read(scratch.path().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// [`run_file`] as text.
+pub fn run_text(dir: &Path, name: &str) -> String {
+    String::from_utf8(run_file(dir, name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Asserts that the record `files` of the run folders `a` and `b` are the same, byte for byte ([`run_file`]).
 pub fn assert_same_records(a: &Path, b: &Path, files: &[&str]) {
     for file in files {
-        let read =
-            |dir: &Path| std::fs::read(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let read = |dir: &Path| run_file(dir, file);
         assert!(
             read(a) == read(b),
             "{file} differs between {} and {}",

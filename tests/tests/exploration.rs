@@ -34,7 +34,7 @@ fn tick(row: &[String]) -> u64 {
 
 /// `(tick, robot)` of every `event` in `events.csv`.
 fn events(out: &Path, event: &str) -> Vec<(u64, u32)> {
-    let text = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let text = swarm_system_tests::run_text(out, "events.csv");
     text.lines()
         .skip(1)
         .map(|l| l.split(',').collect::<Vec<_>>())
@@ -140,7 +140,7 @@ fn a_killed_coordinator_is_restarted_and_loses_no_task_the_robots_found() {
     let m = metrics(&out);
     assert_eq!(m["tasks_completed"], 3, "{m}");
     assert_eq!(tick(&task_rows(&out, "discovered")[0]), discovered);
-    let messages = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
+    let messages = swarm_system_tests::run_text(&out, "messages.csv");
     let down = format!(",{COORDINATOR},one,");
     assert!(
         messages

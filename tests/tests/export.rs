@@ -1,58 +1,81 @@
-//! `swarm export`: a recorded run's files as Parquet and back, through the command a user types.
+//! The records a run leaves (Parquet by default, CSV with `--records csv`) and `swarm export` between the two,
+//! through the commands a user types.
 
 use swarm_system_tests::{run_to_completion, swarm};
 
 #[test]
-fn a_run_exported_to_parquet_and_back_gives_the_worlds_csv_byte_for_byte() {
-    let run = tempfile::tempdir().expect("temp dir");
-    let outcome = run_to_completion(
-        "configs/messages/coordinator.argos",
-        run.path(),
-        &["--ticks", "60"],
+fn a_run_leaves_parquet_records_that_export_gives_back_as_the_worlds_csv_byte_for_byte() {
+    let (parquet_run, csv_run) = (
+        tempfile::tempdir().expect("temp dir"),
+        tempfile::tempdir().expect("temp dir"),
     );
-    assert!(outcome.output.status.success(), "{}", outcome.stderr());
-    let dir = run.path().display().to_string();
+    let common = ["--ticks", "60", "--seed", "5"];
+    for (run, extra) in [
+        (&parquet_run, &[][..]),
+        (&csv_run, &["--records", "csv"][..]),
+    ] {
+        let args: Vec<&str> = common.iter().chain(extra).copied().collect();
+        let outcome = run_to_completion("configs/messages/coordinator.argos", run.path(), &args);
+        assert!(outcome.output.status.success(), "{}", outcome.stderr());
+    }
     let tables = ["trajectory", "events", "messages"];
+    let read = |run: &tempfile::TempDir, name: String| {
+        std::fs::read(run.path().join(&name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    for table in tables {
+        // The default leaves Parquet files only; `--records csv` leaves the world's CSV files only.
+        assert_eq!(
+            &read(&parquet_run, format!("{table}.parquet"))[..4],
+            b"PAR1"
+        );
+        assert!(!parquet_run.path().join(format!("{table}.csv")).exists());
+        assert!(!csv_run.path().join(format!("{table}.parquet")).exists());
+    }
     let recorded: Vec<Vec<u8>> = tables
         .iter()
-        .map(|t| std::fs::read(run.path().join(format!("{t}.csv"))).expect("a record file"))
+        .map(|t| read(&csv_run, format!("{t}.csv")))
         .collect();
 
-    let to_parquet = swarm(&["export", &dir, "--format", "parquet"]);
+    let dir = parquet_run.path().display().to_string();
+    let to_csv = swarm(&["export", &dir, "--format", "csv"]);
+    assert!(to_csv.output.status.success(), "{}", to_csv.stderr());
+    for (table, original) in tables.iter().zip(&recorded) {
+        assert!(
+            to_csv
+                .stdout()
+                .contains(&format!("{table}.parquet -> {table}.csv")),
+            "{}",
+            to_csv.stdout()
+        );
+        assert!(
+            read(&parquet_run, format!("{table}.csv")) == *original,
+            "{table}.csv of the Parquet run differs from the CSV run's"
+        );
+    }
+
+    let csv_dir = csv_run.path().display().to_string();
+    let to_parquet = swarm(&["export", &csv_dir, "--format", "parquet"]);
     assert!(
         to_parquet.output.status.success(),
         "{}",
         to_parquet.stderr()
     );
     for table in tables {
+        let name = format!("{table}.parquet");
         assert!(
-            to_parquet
-                .stdout()
-                .contains(&format!("{table}.csv -> {table}.parquet")),
-            "{}",
-            to_parquet.stdout()
+            read(&csv_run, name.clone()) == read(&parquet_run, name.clone()),
+            "{name} exported from the CSV run differs from the one the run left"
         );
-        let header =
-            std::fs::read(run.path().join(format!("{table}.parquet"))).expect("a Parquet file");
-        assert_eq!(&header[..4], b"PAR1");
+    }
+
+    let run = parquet_run;
+    for table in tables {
         std::fs::remove_file(run.path().join(format!("{table}.csv"))).expect("CSV removed");
     }
-
-    let to_csv = swarm(&["export", &dir, "--format", "csv"]);
-    assert!(to_csv.output.status.success(), "{}", to_csv.stderr());
-    for (table, original) in tables.iter().zip(&recorded) {
-        let again = std::fs::read(run.path().join(format!("{table}.csv"))).expect("CSV again");
-        assert!(
-            again == *original,
-            "{table}.csv differs after the round trip"
-        );
-    }
-
     // A cut Parquet file is refused with its name, and nothing is half written.
     let trajectory = run.path().join("trajectory.parquet");
     let bytes = std::fs::read(&trajectory).expect("Parquet");
     std::fs::write(&trajectory, &bytes[..bytes.len() / 2]).expect("cut");
-    std::fs::remove_file(run.path().join("trajectory.csv")).expect("CSV removed");
     let refused = swarm(&["export", &dir, "--format", "csv"]);
     assert_eq!(refused.output.status.code(), Some(1));
     assert!(

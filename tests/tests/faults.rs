@@ -60,7 +60,7 @@ fn summary(out: &Path) -> serde_json::Value {
 
 /// `trajectory.csv` as (tick, robot index, alive, led sum) rows; robots are in index order within a tick.
 fn trajectory(out: &Path) -> Vec<(u64, usize, bool, u32)> {
-    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(out, "trajectory.csv");
     text.lines()
         .skip(1)
         .enumerate()
@@ -85,7 +85,7 @@ fn trajectory(out: &Path) -> Vec<(u64, usize, bool, u32)> {
 
 /// `events.csv` as (tick, robot index, event) rows.
 fn events(out: &Path) -> Vec<(u64, usize, String)> {
-    let text = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let text = swarm_system_tests::run_text(out, "events.csv");
     text.lines()
         .skip(1)
         .map(|line| {
@@ -333,6 +333,11 @@ fn killing_the_world_stops_every_agent_and_keeps_the_record_readable() {
     let rows = trajectory(out.path());
     assert_eq!(rows.len(), 50 * ROBOTS, "ticks 0..=49, complete");
     assert_eq!(rows.last().map(|r| r.0), Some(49));
+    // The records were cut back to whole ticks, then left as Parquet like any run's.
+    for table in ["trajectory", "events"] {
+        assert!(out.path().join(format!("{table}.parquet")).exists());
+        assert!(!out.path().join(format!("{table}.csv")).exists());
+    }
     let summary = summary(out.path());
     assert_eq!(faults(&summary)[0]["what"], "kill-world");
     assert!(
@@ -355,7 +360,7 @@ fn same_seed_and_fault_schedule_give_identical_records() {
     let records = || {
         let out = temp_dir();
         run_ok(out.path(), 80, &schedule);
-        let read = |name: &str| std::fs::read(out.path().join(name)).expect("record exists");
+        let read = |name: &str| swarm_system_tests::run_file(out.path(), name);
         (read("trajectory.csv"), read("events.csv"))
     };
     let first = records();

@@ -114,7 +114,7 @@ fn summary(out: &Path) -> serde_json::Value {
 }
 
 fn read(out: &Path, name: &str) -> Vec<u8> {
-    std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+    swarm_system_tests::run_file(out, name)
 }
 
 /// Runs `config` with the arguments `common` once on this machine and once on two hosts, both to success and the

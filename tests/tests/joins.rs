@@ -11,7 +11,7 @@ use swarm_system_tests::{
 const LATE_ARRIVALS: &str = "configs/joins/late_arrivals.argos";
 
 fn text(out: &Path, file: &str) -> String {
-    std::fs::read_to_string(out.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+    swarm_system_tests::run_text(out, file)
 }
 
 fn summary(out: &Path) -> serde_json::Value {

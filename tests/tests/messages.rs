@@ -31,7 +31,7 @@ fn run(out: &Path, extra: &[&str]) {
 
 /// The rows of `messages.csv` (of a live run: the lines written so far, up to the last whole one).
 fn messages(out: &Path) -> Vec<Row> {
-    let text = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
+    let text = swarm_system_tests::run_text(out, "messages.csv");
     let whole = text.rfind('\n').map_or("", |end| &text[..end]);
     let mut lines = whole.lines();
     assert_eq!(
@@ -55,7 +55,7 @@ fn messages(out: &Path) -> Vec<Row> {
 
 /// What each robot's agent read per tick: `led_r` of `trajectory.csv` (the probe shows its inbox's size there).
 fn read_per_tick(out: &Path) -> BTreeMap<(u64, u32), u32> {
-    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(out, "trajectory.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
@@ -148,7 +148,7 @@ fn the_same_seed_gives_the_same_messages_and_another_seed_other_losses() {
 }
 
 fn text(out: &Path, file: &str) -> String {
-    std::fs::read_to_string(out.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+    swarm_system_tests::run_text(out, file)
 }
 
 #[test]

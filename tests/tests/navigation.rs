@@ -13,7 +13,7 @@ const CASE1: &str = "configs/navigation/case1.argos";
 
 /// `(x, y)` of every robot in `tick`'s rows of `trajectory.csv`.
 fn poses(out: &Path, tick: u64) -> Vec<(f64, f64)> {
-    let trajectory = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out, "trajectory.csv");
     trajectory
         .lines()
         .skip(1)
@@ -38,7 +38,7 @@ fn eight_robots_cross_the_obstacle_rows_and_every_one_arrives_the_same_way_for_a
     let arrivals = std::fs::read_to_string(out.join("navigation.csv")).expect("navigation.csv");
     assert_eq!(arrivals.lines().count(), 9, "{arrivals}");
     // Goals reached and messages go through the world: the task server's letters are recorded.
-    let messages = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
+    let messages = swarm_system_tests::run_text(out, "messages.csv");
     assert!(
         messages.lines().any(|l| l.starts_with("1,world,0,one,")),
         "{}",
@@ -78,7 +78,7 @@ fn without_the_coordinator_robots_hold_still_and_they_finish_once_it_is_back() {
             "{p:?} -> {q:?}"
         );
     }
-    let events = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let events = swarm_system_tests::run_text(&out, "events.csv");
     assert!(
         events.lines().any(|l| l.ends_with(",coordinator_lost")),
         "no robot lost its coordinator"

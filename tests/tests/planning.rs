@@ -40,7 +40,7 @@ fn cylinders(path: &str) -> Vec<(String, f64, f64, f64)> {
 
 /// The closest the robot's centre came to each cylinder's edge, by id.
 fn closest_approach(out: &Path, config: &str) -> Vec<(String, f64)> {
-    let trajectory = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out, "trajectory.csv");
     let poses: Vec<(f64, f64)> = trajectory
         .lines()
         .skip(1)
@@ -95,10 +95,10 @@ fn a_gsa_robot_finds_the_hidden_cylinders_replans_and_arrives_the_same_way_for_a
             "{id}: the centre came within {closest} m of its edge"
         );
     }
-    let events = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let events = swarm_system_tests::run_text(out, "events.csv");
     assert!(events.lines().any(|l| l.ends_with(",path_blocked")));
     // The robot's reports reach the world, recorded as letters to it.
-    let messages = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
+    let messages = swarm_system_tests::run_text(out, "messages.csv");
     assert!(
         messages
             .lines()

@@ -43,7 +43,7 @@ fn run_in(cwd: &Path, config: &Path, out: &Path, extra: &[&str]) {
 
 /// Each robot's positions by tick, from `trajectory.csv`.
 fn positions(out: &Path) -> BTreeMap<u32, Vec<(u64, f64, f64)>> {
-    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(out, "trajectory.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
@@ -202,8 +202,7 @@ fn a_mixed_swarm_runs_every_kind_with_its_own_controller() {
         out.path(),
         &["--ticks", "100"],
     );
-    let trajectory =
-        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out.path(), "trajectory.csv");
     for id in ["ep0", "ep5", "fb0", "fb2", "disc0", "disc1"] {
         assert!(
             trajectory.contains(&format!(",{id},")),
@@ -224,7 +223,7 @@ fn a_mixed_swarm_runs_every_kind_with_its_own_controller() {
 /// The LED ring's red component per robot per tick, from `trajectory.csv`: the ticks at which each robot
 /// flashed.
 fn flash_ticks(out: &Path) -> BTreeMap<u64, Vec<u32>> {
-    let text = std::fs::read_to_string(out.join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(out, "trajectory.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
@@ -361,7 +360,7 @@ fn footbot_foraging_brings_items_to_the_nest_and_writes_its_output_in_the_run_fo
 
 /// The `gripper:*` and `fault:*` rows of `events.csv` as (tick, robot, event).
 fn gripper_and_fault_events(out: &Path) -> Vec<(u64, u32, String)> {
-    let text = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let text = swarm_system_tests::run_text(out, "events.csv");
     text.lines()
         .skip(1)
         .filter_map(|line| {
@@ -452,9 +451,7 @@ fn two_footbots_pull_one_box_and_one_dying_lets_go() {
 
 #[test]
 fn runs_of_every_kind_are_a_pure_function_of_configuration_and_seed() {
-    let read = |out: &Path, file: &str| {
-        std::fs::read_to_string(out.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
-    };
+    let read = |out: &Path, file: &str| swarm_system_tests::run_text(out, file);
     // A mixed swarm (all three bodies, three controllers) and the foraging example (random draws in the
     // controller and in the loop functions, range and bearing between robots).
     for (config, files, ticks) in [
@@ -533,7 +530,7 @@ fn footbot_and_range_finder_readings_reach_the_controllers_as_geometry_says() {
     std::fs::write(&path, config).expect("write the configuration");
     let out = temp_dir();
     run_config(&path, out.path(), &["--ticks", "3"]);
-    let text = std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(out.path(), "trajectory.csv");
     let led = |id: &str| -> [i64; 3] {
         let row = text
             .lines()

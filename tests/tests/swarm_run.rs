@@ -82,14 +82,13 @@ fn forty_robot_run_completes_with_one_process_per_robot() {
         let used = summary[cpu].as_f64().unwrap_or(0.0);
         assert!(used > 0.0, "{cpu} is measured: {}", summary[cpu]);
     }
-    let trajectory =
-        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out.path(), "trajectory.csv");
     assert_eq!(
         trajectory.lines().count(),
         1 + 41 * 40,
         "a header, then 40 robots at ticks 0..=40"
     );
-    let events = std::fs::read_to_string(out.path().join("events.csv")).expect("events.csv");
+    let events = swarm_system_tests::run_text(out.path(), "events.csv");
     assert!(events.lines().skip(1).all(|l| l.split(',').count() == 4));
     assert!(
         events.contains(",Go\n") && events.contains(",saw-obs\n"),
@@ -120,7 +119,7 @@ fn same_seed_gives_identical_trajectory_and_events() {
             out.path(),
             &["--ticks", "60", "--seed", seed],
         );
-        let read = |name: &str| std::fs::read(out.path().join(name)).expect("record exists");
+        let read = |name: &str| swarm_system_tests::run_file(out.path(), name);
         let summary: serde_json::Value =
             serde_json::from_slice(&read("summary.json")).expect("summary.json is JSON");
         assert_eq!(
@@ -172,7 +171,7 @@ fn the_run_folders_configuration_reruns_the_same_run_from_elsewhere() {
     let second = temp_dir();
     run_ok(&copy.display().to_string(), second.path(), &[]);
     for name in ["trajectory.csv", "events.csv"] {
-        let read = |dir: &Path| std::fs::read(dir.join(name)).expect("a record");
+        let read = |dir: &Path| swarm_system_tests::run_file(dir, name);
         assert!(
             read(first.path()) == read(second.path()),
             "{name} of the rerun differs from the run"
@@ -213,8 +212,7 @@ fn a_run_stops_cleanly_at_its_disk_budget_with_its_records_complete() {
     assert!(summary["stopped_early"].is_string(), "{summary:#}");
     let ticks = summary["ticks"].as_u64().expect("ticks");
     assert!(ticks > 0, "{summary:#}");
-    let trajectory =
-        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out.path(), "trajectory.csv");
     assert!(trajectory.ends_with('\n'), "a torn last line");
     let last_tick: u64 = trajectory
         .lines()
@@ -300,7 +298,9 @@ fn assert_fails_before_first_tick(config: &str, out: &Path, expected: &[&str]) {
         1,
         "the error is said once:\n{stderr}"
     );
-    assert!(!out.join("trajectory.csv").exists(), "no tick may run");
+    for records in ["trajectory.csv", "trajectory.parquet"] {
+        assert!(!out.join(records).exists(), "no tick may run");
+    }
     assert_clean(&outcome);
 }
 
@@ -440,8 +440,7 @@ fn interrupt_stops_the_run_cleanly_with_every_record_flushed() {
     assert_eq!(summary["interrupted"], true);
     let ticks = summary["ticks"].as_u64().expect("ticks are counted");
     assert!(ticks >= 1);
-    let trajectory =
-        std::fs::read_to_string(out.path().join("trajectory.csv")).expect("trajectory.csv");
+    let trajectory = swarm_system_tests::run_text(out.path(), "trajectory.csv");
     let last_tick: u64 = trajectory
         .lines()
         .last()

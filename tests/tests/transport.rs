@@ -47,7 +47,7 @@ fn two_robots_carry_the_box_to_its_goal_pose_the_same_way_for_a_seed() {
     assert_delivered(out);
     // The box was lifted before it moved and lowered at the end.
     assert!(first(out, "lifted") < first(out, "lowered"));
-    let events = std::fs::read_to_string(out.join("events.csv")).expect("events.csv");
+    let events = swarm_system_tests::run_text(out, "events.csv");
     assert!(events.contains("gripper:lifted") && events.contains(",take"));
     assert_same_records(
         out,
@@ -142,7 +142,7 @@ fn lost_messages_are_sent_again_and_the_box_still_arrives() {
     let out = dir.path().join("lossy");
     run_to_completion(&config, &out, &[]);
     assert_delivered(&out);
-    let messages = std::fs::read_to_string(out.join("messages.csv")).expect("messages.csv");
+    let messages = swarm_system_tests::run_text(&out, "messages.csv");
     assert!(
         messages.lines().any(|l| l.ends_with(",lost")),
         "no message was lost"

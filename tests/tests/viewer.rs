@@ -14,7 +14,7 @@ const CONFIG: &str = "configs/foraging/quick.argos";
 
 /// Every robot's (x, y, heading, alive) at every tick of `trajectory.csv`.
 fn trajectory(dir: &Path) -> HashMap<u64, Vec<(f32, f32, f32, bool)>> {
-    let text = std::fs::read_to_string(dir.join("trajectory.csv")).expect("trajectory.csv");
+    let text = swarm_system_tests::run_text(dir, "trajectory.csv");
     let mut ticks: HashMap<u64, Vec<(f32, f32, f32, bool)>> = HashMap::new();
     for line in text.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
@@ -60,7 +60,7 @@ fn replayed_states(dir: &Path, robot: usize, tick: u64) -> Vec<(String, u64)> {
         .map(|(id, e)| (e.name.as_str(), id as u8))
         .collect();
     let mut states = vec![0u16; set.supervisors.len()];
-    let events = std::fs::read_to_string(dir.join("events.csv")).expect("events.csv");
+    let events = swarm_system_tests::run_text(dir, "events.csv");
     for line in events.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         let (t, r) = (
@@ -220,7 +220,7 @@ fn live_view_follows_a_running_swarm_and_the_run_goes_on_when_it_closes() {
 #[test]
 fn bad_run_directories_are_explained_in_the_page_and_the_terminal() {
     let run = tempfile::tempdir().expect("temp dir");
-    let outcome = run_to_completion(CONFIG, run.path(), &["--ticks", "50"]);
+    let outcome = run_to_completion(CONFIG, run.path(), &["--ticks", "50", "--records", "csv"]);
     assert!(outcome.output.status.success(), "{}", outcome.stderr());
 
     // An older run (no scene.json) and a trajectory cut in the middle of a row.
@@ -242,7 +242,7 @@ fn bad_run_directories_are_explained_in_the_page_and_the_terminal() {
     assert_eq!(browser.console_errors(), Vec::<String>::new());
 
     // A malformed row: the page names the file and line, the server keeps serving.
-    let mut rows = String::from_utf8(text).expect("UTF-8");
+    let mut rows = String::from_utf8(text.clone()).expect("UTF-8");
     rows.insert_str(
         rows.find("\n1,").expect("tick 1") + 1,
         "1,zero,ep0,1,1,1,0,0,0,1\n",
@@ -260,8 +260,37 @@ fn bad_run_directories_are_explained_in_the_page_and_the_terminal() {
         problems.contains("trajectory.csv:7: `zero` in the `robot` column"),
         "{problems}"
     );
+
+    // A Parquet trajectory cut short: the page names the file, the server keeps serving.
+    let cut = tempfile::tempdir().expect("temp dir");
+    std::fs::copy(
+        run.path().join("summary.json"),
+        cut.path().join("summary.json"),
+    )
+    .expect("copied");
+    std::fs::write(cut.path().join("trajectory.csv"), &text).expect("written");
+    let exported = swarm_system_tests::swarm(&[
+        "export",
+        &cut.path().display().to_string(),
+        "--format",
+        "parquet",
+    ]);
+    assert!(exported.output.status.success(), "{}", exported.stderr());
+    std::fs::remove_file(cut.path().join("trajectory.csv")).expect("CSV removed");
+    let parquet = cut.path().join("trajectory.parquet");
+    let bytes = std::fs::read(&parquet).expect("Parquet");
+    std::fs::write(&parquet, &bytes[..bytes.len() - 20]).expect("cut");
+    let third = ServedPage::start(&["view", &cut.path().display().to_string(), "--port", "0"]);
+    browser.open(&third.url);
+    browser.wait_for("viewer.ready");
+    let problems = browser.eval("viewer.problems()").to_string();
+    assert!(
+        problems.contains("trajectory.parquet: not a readable Parquet file"),
+        "{problems}"
+    );
     browser.open(&page.url);
     browser.wait_for("viewer.ready");
+    assert_eq!(third.interrupt(), Some(130));
     assert_eq!(second.interrupt(), Some(130));
     assert_eq!(page.interrupt(), Some(130));
 

@@ -9,5 +9,4 @@
 
 pub mod bench;
 pub mod experiment;
-pub mod export;
 pub mod launcher;

@@ -2,6 +2,7 @@
 //!
 //! `summary.json`, `trajectory.csv`, `events.csv`, `snapshot_<tick>.png` and `resume/` (the resume point of every
 //! robot the world marks down, for its replacement if one is started) are written by the world; the launcher adds
+//! the record tables' Parquet files when the run ends (replacing their CSV files unless the run keeps CSV),
 //! `config.argos` (the configuration as run), `logs/` (one log per local agent, kept so a failed start can be
 //! explained), `supervisors/` (each controller's compiled supervisor set), `event_tables.json`, `control.sock`
 //! (`swarm ctl`) and its own fields in `summary.json`. A batch of `swarm experiment` marks each finished run with
@@ -20,6 +21,12 @@ pub const TRAJECTORY_FILE: &str = "trajectory.csv";
 pub const EVENTS_FILE: &str = "events.csv";
 /// Every addressed message's fate (runs with a `<messages>` medium).
 pub const MESSAGES_FILE: &str = "messages.csv";
+/// [`TRAJECTORY_FILE`] as Apache Parquet, converted when the run ended.
+pub const TRAJECTORY_PARQUET_FILE: &str = "trajectory.parquet";
+/// [`EVENTS_FILE`] as Apache Parquet, converted when the run ended.
+pub const EVENTS_PARQUET_FILE: &str = "events.parquet";
+/// [`MESSAGES_FILE`] as Apache Parquet, converted when the run ended.
+pub const MESSAGES_PARQUET_FILE: &str = "messages.parquet";
 /// What does not move with the robots: the arena, obstacles, targets and lights as placed, each robot's id,
 /// controller and body (`swarm view` draws the run over it).
 pub const SCENE_FILE: &str = "scene.json";

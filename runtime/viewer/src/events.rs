@@ -1,9 +1,12 @@
-//! `events.csv` held per participant in a compact form (tick and an interned name, 12 bytes a row), with what
-//! the viewer derives from it: the faults, joins and leaves of the timeline, and when each robot was frozen or
-//! held something in its gripper. The index grows as the file does (a live run).
+//! A run's events held per participant in a compact form (tick and an interned name, 12 bytes a row), with what
+//! the viewer derives from them: the faults, joins and leaves of the timeline, and when each robot was frozen or
+//! held something in its gripper. They are read from `events.parquet` when the run's records have been
+//! converted, else from `events.csv`, whose index grows as the file does (a live run).
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use swarm_records::{ParquetTable, Table as RecordTable, Value};
 
 use crate::lines::GrowingLines;
 
@@ -67,6 +70,9 @@ struct Participant {
 /// The events of one run.
 pub struct EventsIndex {
     lines: GrowingLines,
+    /// `events.parquet` beside the CSV file, read whole once it exists.
+    parquet: PathBuf,
+    parquet_read: bool,
     table: Table,
     problem: Option<String>,
 }
@@ -82,19 +88,14 @@ struct Table {
 }
 
 impl EventsIndex {
-    /// An index of the file at `path` of a run with `participants` robots and coordinators (`None`: unknown).
-    pub fn new(path: &Path, participants: Option<usize>) -> Self {
+    /// An index of the run folder `dir`'s events, of a run with `participants` robots and coordinators (`None`:
+    /// unknown).
+    pub fn new(dir: &Path, participants: Option<usize>) -> Self {
         Self {
-            lines: GrowingLines::new(path),
-            table: Table {
-                header_seen: false,
-                participants_limit: participants.unwrap_or(MAX_PARTICIPANTS),
-                names: Vec::new(),
-                name_ids: HashMap::new(),
-                participants: Vec::new(),
-                markers: Vec::new(),
-                markers_truncated: false,
-            },
+            lines: GrowingLines::new(&dir.join(RecordTable::Events.csv_name())),
+            parquet: dir.join(RecordTable::Events.parquet_name()),
+            parquet_read: false,
+            table: Table::new(participants.unwrap_or(MAX_PARTICIPANTS)),
             problem: None,
         }
     }
@@ -104,8 +105,26 @@ impl EventsIndex {
         self.problem.as_deref()
     }
 
-    /// Reads the rows written since the last call. Returns whether the file exists.
+    /// Reads the rows written since the last call: all of `events.parquet` once it exists (the run's records were
+    /// converted when it ended), else the new lines of `events.csv`. Returns whether either file exists.
     pub fn update(&mut self) -> bool {
+        if self.parquet_read {
+            return true;
+        }
+        if self.parquet.exists() {
+            self.parquet_read = true;
+            let mut table = Table::new(self.table.participants_limit);
+            table.header_seen = true;
+            let read = ParquetTable::open(RecordTable::Events, &self.parquet).and_then(|file| {
+                (0..file.row_groups()).try_for_each(|group| {
+                    file.read_row_group(group, |_, values| table.add_row(values))
+                        .map(drop)
+                })
+            });
+            self.table = table;
+            self.problem = read.err().map(|e| e.to_string());
+            return true;
+        }
         let table = &mut self.table;
         self.lines
             .read_until_problem(&mut self.problem, |line| table.add(line.text))
@@ -138,6 +157,38 @@ impl EventsIndex {
 }
 
 impl Table {
+    fn new(participants_limit: usize) -> Table {
+        Table {
+            header_seen: false,
+            participants_limit,
+            names: Vec::new(),
+            name_ids: HashMap::new(),
+            participants: Vec::new(),
+            markers: Vec::new(),
+            markers_truncated: false,
+        }
+    }
+
+    /// Adds a row of `events.parquet` (the reader has checked the columns' types).
+    fn add_row(&mut self, values: &[Value<'_>]) -> Result<(), String> {
+        match values {
+            [
+                Value::Int64(tick),
+                Value::Int32(robot),
+                Value::Text(id),
+                Value::Text(event),
+            ] => {
+                let robot = *robot as u32 as usize;
+                let robot = (robot < self.participants_limit)
+                    .then_some(robot)
+                    .ok_or_else(|| format!("robot {robot} is not a participant of this run"))?;
+                self.add_event(*tick as u64, robot, utf8(id)?, utf8(event)?)
+            }
+            _ => Err("the row is not an events row".to_owned()),
+        }
+    }
+
+    /// Adds a line of `events.csv` (the first is its header).
     fn add(&mut self, text: &[u8]) -> Result<(), String> {
         let text = std::str::from_utf8(text).map_err(|_| "the row is not UTF-8".to_owned())?;
         if !self.header_seen {
@@ -173,6 +224,10 @@ impl Table {
                 format!("`{robot_text}` in the `robot` column is not a participant of this run")
             })?;
         let id = next("robot_id")?;
+        self.add_event(tick, robot, id, event)
+    }
+
+    fn add_event(&mut self, tick: u64, robot: usize, id: &str, event: &str) -> Result<(), String> {
         let name = self.intern(event)?;
         if self.participants.len() <= robot {
             self.participants
@@ -221,6 +276,10 @@ impl Table {
     }
 }
 
+fn utf8(value: &[u8]) -> Result<&str, String> {
+    std::str::from_utf8(value).map_err(|_| "a text column is not UTF-8".to_owned())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -236,7 +295,7 @@ mod tests {
             ),
         )
         .expect("written");
-        let mut index = EventsIndex::new(&path, Some(2));
+        let mut index = EventsIndex::new(dir.path(), Some(2));
         assert!(index.update());
         assert_eq!(index.problem(), None);
         let (markers, truncated) = index.markers();
@@ -259,7 +318,7 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let path = dir.path().join("events.csv");
         std::fs::write(&path, format!("{HEADER}\n4,0,ep,0,fault:kill\n")).expect("written");
-        let mut index = EventsIndex::new(&path, Some(1));
+        let mut index = EventsIndex::new(dir.path(), Some(1));
         index.update();
         assert_eq!(index.problem(), None);
         let (markers, _) = index.markers();
@@ -274,7 +333,7 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let path = dir.path().join("events.csv");
         std::fs::write(&path, format!("{HEADER}\n1,0,ep0,go\n1,9,ep9,go\n")).expect("written");
-        let mut index = EventsIndex::new(&path, Some(2));
+        let mut index = EventsIndex::new(dir.path(), Some(2));
         index.update();
         let problem = index.problem().expect("a problem");
         assert!(

@@ -11,10 +11,12 @@ pub mod frames;
 pub mod lines;
 pub mod objects;
 pub mod page;
+pub mod parquet_trajectory;
 pub mod run;
 pub mod server;
 pub mod supervisors;
 pub mod trajectory;
+pub mod trajectory_source;
 
 use std::net::{IpAddr, SocketAddr, TcpListener};
 use std::path::Path;

@@ -7,15 +7,14 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use swarm_contract::run_dir::{
-    EVENTS_FILE, FLOOR_IMAGE_FILE, OBJECTS_FILE, PHEROMONE_FILE, SCENE_FILE, SUMMARY_FILE,
-    TRAJECTORY_FILE,
+    FLOOR_IMAGE_FILE, OBJECTS_FILE, PHEROMONE_FILE, SCENE_FILE, SUMMARY_FILE,
 };
 
 use crate::events::EventsIndex;
 use crate::frames::{self, FrameRobot};
 use crate::objects::{ObjectPlaces, ObjectsIndex};
 use crate::supervisors::Supervisors;
-use crate::trajectory::TrajectoryIndex;
+use crate::trajectory_source::TrajectorySource;
 
 /// The `format` of `scene.json` this version reads.
 pub const SCENE_FORMAT: u64 = 1;
@@ -46,8 +45,7 @@ pub struct RunRecord {
     scene: Option<Value>,
     scene_problem: Option<String>,
     robots: Vec<RobotInfo>,
-    trajectory: TrajectoryIndex,
-    trajectory_file: Option<File>,
+    trajectory: TrajectorySource,
     events: EventsIndex,
     objects: ObjectsIndex,
     supervisors: Supervisors,
@@ -76,9 +74,8 @@ impl RunRecord {
             scene: None,
             scene_problem: None,
             robots: Vec::new(),
-            trajectory: TrajectoryIndex::new(&dir.join(TRAJECTORY_FILE), None),
-            trajectory_file: None,
-            events: EventsIndex::new(&dir.join(EVENTS_FILE), None),
+            trajectory: TrajectorySource::new(dir, None),
+            events: EventsIndex::new(dir, None),
             objects: ObjectsIndex::new(&dir.join(OBJECTS_FILE), 0, 0),
             supervisors: Supervisors::new(dir),
         };
@@ -101,9 +98,7 @@ impl RunRecord {
         if self.scene.is_none() {
             self.load_scene();
         }
-        if self.trajectory.update() && self.trajectory_file.is_none() {
-            self.trajectory_file = File::open(self.dir.join(TRAJECTORY_FILE)).ok();
-        }
+        self.trajectory.update();
         self.events.update();
         self.objects.update();
     }
@@ -140,15 +135,14 @@ impl RunRecord {
             })
             .unwrap_or_default();
         let participants = robots.len() + scene["coordinators"].as_array().map_or(0, Vec::len);
-        self.trajectory = TrajectoryIndex::new(&self.dir.join(TRAJECTORY_FILE), Some(robots.len()));
-        self.events = EventsIndex::new(&self.dir.join(EVENTS_FILE), Some(participants));
+        self.trajectory = TrajectorySource::new(&self.dir, Some(robots.len()));
+        self.events = EventsIndex::new(&self.dir, Some(participants));
         let count = |key: &str| scene[key].as_array().map_or(0, Vec::len);
         self.objects = ObjectsIndex::new(
             &self.dir.join(OBJECTS_FILE),
             count("targets"),
             count("obstacles"),
         );
-        self.trajectory_file = None;
         self.robots = robots;
         self.scene_problem = None;
         self.scene = Some(scene);
@@ -161,15 +155,15 @@ impl RunRecord {
         problems.extend(self.events.problem().map(str::to_owned));
         problems.extend(self.objects.problem().map(str::to_owned));
         let finished = self.finished();
-        if !self.dir.join(TRAJECTORY_FILE).exists() && (finished || !self.live) {
+        if !self.trajectory.exists() && (finished || !self.live) {
             problems.push(format!(
                 "{} is missing: the run recorded no poses",
-                self.dir.join(TRAJECTORY_FILE).display()
+                self.trajectory.path().display()
             ));
         } else if finished && self.trajectory.unfinished_bytes() > 0 {
             problems.push(format!(
                 "{}: the last {} bytes are not a whole row (the file was cut short); the ticks before them are shown",
-                self.dir.join(TRAJECTORY_FILE).display(),
+                self.trajectory.path().display(),
                 self.trajectory.unfinished_bytes()
             ));
         }
@@ -268,7 +262,7 @@ impl RunRecord {
         let count = count
             .min(MAX_FRAMES)
             .min((MAX_FRAME_BYTES / frame_bytes).max(1));
-        let (first, last, _) = self.readable_trajectory()?;
+        let (first, last) = self.readable_trajectory()?;
         let ticks: Vec<u64> = (0..count)
             .map_while(|i| {
                 i.checked_mul(stride)
@@ -287,10 +281,10 @@ impl RunRecord {
     /// Every robot of the complete tick `tick`, by robot index: its trajectory row with the frozen and carrying
     /// flags of the events up to it.
     pub fn poses(&self, tick: u64) -> Result<Vec<FrameRobot>, Refusal> {
-        let (_, _, file) = self.readable_trajectory()?;
+        self.readable_trajectory()?;
         let poses = self
             .trajectory
-            .read_tick(file, tick)
+            .read_tick(tick)
             .map_err(Refusal::Unavailable)?;
         Ok(poses
             .into_iter()
@@ -306,14 +300,11 @@ impl RunRecord {
             .collect())
     }
 
-    /// The first and last complete ticks and the open trajectory, or why there is none.
-    fn readable_trajectory(&self) -> Result<(u64, u64, &File), Refusal> {
-        match (
-            self.trajectory.complete_ticks(),
-            self.trajectory_file.as_ref(),
-        ) {
-            (Some((first, last)), Some(file)) => Ok((first, last, file)),
-            _ => Err(Refusal::Unavailable(
+    /// The first and last complete ticks, or why there is none.
+    fn readable_trajectory(&self) -> Result<(u64, u64), Refusal> {
+        match self.trajectory.complete_ticks() {
+            Some(ticks) => Ok(ticks),
+            None => Err(Refusal::Unavailable(
                 self.problems()
                     .into_iter()
                     .next()

@@ -117,15 +117,19 @@ enum Commands {
             default_value = "127.0.0.1"
         )]
         view_bind: IpAddr,
+        /// The format the run's records (trajectory, events, messages) are left in: Parquet, converted from the
+        /// CSV the world appends while the run goes, or that CSV as it is (docs/records.md).
+        #[arg(long, value_enum, value_name = "FORMAT", default_value_t = swarm_records::Format::Parquet)]
+        records: swarm_records::Format,
     },
-    /// Convert a run's record files (trajectory, events, messages) to Apache Parquet beside the CSV files, for
-    /// pandas and polars (`pd.read_parquet`), or back to CSV (docs/records.md).
+    /// Convert a run's record files (trajectory, events, messages) to CSV beside the Parquet files a run leaves,
+    /// or to Apache Parquet beside the CSV files of a `--records csv` run (docs/records.md).
     Export {
         /// The run directory.
         run: PathBuf,
         /// The format to write.
         #[arg(long, value_enum)]
-        format: swarm_cli::export::Format,
+        format: swarm_records::Format,
     },
     /// Replay a run in the browser: serves a local web page of the run directory and prints its URL; Ctrl-C
     /// stops it (docs/viewer.md). With --gif, writes an animated GIF of the run instead.
@@ -425,6 +429,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             view,
             view_port,
             view_bind,
+            records,
         } => {
             let stop = Arc::new(AtomicBool::new(false));
             let interrupts = interrupt_channel(&stop)?;
@@ -452,6 +457,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 faults,
                 hosts,
                 view: view.then_some(SocketAddr::new(view_bind, view_port)),
+                records,
             };
             let report = launcher::run(&options, stop)
                 .with_context(|| format!("running {}", config.display()))?;
@@ -488,7 +494,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Commands::Export { run, format } => {
-            let report = swarm_cli::export::export(&run, format)
+            let report = swarm_records::export(&run, format)
                 .with_context(|| format!("exporting {} as {format}", run.display()))?;
             for file in &report.files {
                 println!("{file}");

@@ -95,6 +95,9 @@ pub struct RunOptions {
     /// Serve the live viewer of the run at this address (`swarm run --view`); its URL is printed as soon as
     /// the run directory exists.
     pub view: Option<SocketAddr>,
+    /// The format the run's records are left in (`swarm run --records`): the world appends CSV as the run goes;
+    /// with Parquet (the default) they are converted when it ends.
+    pub records: swarm_records::Format,
 }
 
 /// What a finished run reports.
@@ -469,9 +472,9 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
     if let Err(error) = followed {
         supervision.children.kill_all();
         supervision.progress.finish_and_clear();
+        let complete = records::trim_to_complete_ticks(&out_dir, bodies as u32)
+            .map_err(io("cutting the records back to the last complete tick"))?;
         if matches!(error, LaunchError::WorldDied { .. }) {
-            let complete = records::trim_to_complete_ticks(&out_dir, bodies as u32)
-                .map_err(io("cutting the records back to the last complete tick"))?;
             let report = supervision.report(
                 seed,
                 bodies as u32,
@@ -481,6 +484,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
             );
             complete_summary(&out_dir, &report, &provenance, Some(&error.to_string()))?;
         }
+        records::finish(&out_dir, options.records);
         return Err(error);
     }
     supervision.collect_agents();
@@ -492,7 +496,9 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         agent_pids,
         supervision.last_tick,
     );
-    if let Some(reason) = complete_summary(&out_dir, &report, &provenance, None)? {
+    let stopped_early = complete_summary(&out_dir, &report, &provenance, None)?;
+    records::finish(&out_dir, options.records);
+    if let Some(reason) = stopped_early {
         return Err(LaunchError::StoppedEarly {
             ticks: report.ticks,
             reason,

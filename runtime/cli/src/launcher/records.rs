@@ -1,9 +1,14 @@
-//! Making a dead world's records readable: after the world process died, `trajectory.csv`, `events.csv` and
-//! `messages.csv` are cut back to the last tick the trajectory holds completely (a half-written line or tick is
-//! dropped).
+//! The run's records once its world has ended: cut back to whole ticks when the world died, then left in the
+//! format the run was asked for.
 //!
-//! The world's recorder thread flushes a tick's events and messages before its poses, so this only ever removes what a kill
-//! in the middle of writing left behind. It never touches the records of a run whose world finished normally.
+//! After the world process died (or was killed because the run failed), `trajectory.csv`, `events.csv` and
+//! `messages.csv` are cut back to the last tick the trajectory holds completely (a half-written line or tick is
+//! dropped). The world's recorder thread flushes a tick's events and messages before its poses, so this only ever
+//! removes what a kill in the middle of writing left behind. It never touches the records of a run whose world
+//! finished normally.
+//!
+//! Then, unless the run keeps CSV (`swarm run --records csv`), the CSV files become Parquet files
+//! ([`swarm_records::finish_run_records`]).
 
 use std::path::Path;
 
@@ -47,6 +52,24 @@ pub fn trim_to_complete_ticks(run_dir: &Path, robots: u32) -> std::io::Result<Op
         }
     }
     Ok(Some(last))
+}
+
+/// Leaves the records of the ended run in `run_dir` in `format`. A conversion that fails leaves the CSV files
+/// whole and is reported as a warning: the run's records are complete either way.
+pub fn finish(run_dir: &Path, format: swarm_records::Format) {
+    if format == swarm_records::Format::Csv {
+        return;
+    }
+    match swarm_records::finish_run_records(run_dir) {
+        Ok(report) => {
+            for file in &report.files {
+                tracing::debug!("records: {file}");
+            }
+        }
+        Err(e) => {
+            tracing::warn!("the records stay CSV files, their conversion to Parquet failed: {e}")
+        }
+    }
 }
 
 /// The text up to its last newline.

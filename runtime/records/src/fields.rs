@@ -8,7 +8,7 @@ use super::schema::{Column, Kind};
 
 /// One field's value, as Parquet stores it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Value<'a> {
+pub enum Value<'a> {
     /// INT64 (UINT_64 columns hold the bits of the unsigned value).
     Int64(i64),
     /// INT32 (the unsigned columns hold the bits of the unsigned value).
@@ -111,7 +111,7 @@ fn utf8(field: &[u8]) -> Result<&str, String> {
 /// One column's values of a batch of rows, as the Parquet column writer takes them and the reader gives them: the
 /// nulls of an optional column are not among them.
 #[derive(Debug)]
-pub(super) enum Values {
+pub enum Values {
     /// INT64 values.
     Int64(Vec<i64>),
     /// INT32 values.

@@ -1,5 +1,11 @@
-//! `swarm export <run-dir> --format parquet|csv`: a run's record files as Apache Parquet beside the CSV files the
-//! world writes (`trajectory.parquet`, `events.parquet`, `messages.parquet`), and back.
+//! swarm-records: a run's record tables (trajectory, events, messages) in the two formats a run folder can hold
+//! them in, and the conversions between them.
+//!
+//! The world writes the tables as CSV while the run goes (`world/src/recorder/`): appended tick by tick, so that a
+//! run cut short keeps every whole tick and `swarm run --view` can follow the files. When the run ends, the
+//! launcher turns them into Apache Parquet and removes the CSV files ([`finish_run_records`]), unless the run was
+//! asked for CSV (`swarm run --records csv`). `swarm export` converts either way ([`export`]); `swarm view` reads
+//! the Parquet files row group by row group ([`ParquetTable`]).
 //!
 //! The Parquet files keep the CSV columns, names and order (docs/records.md) with typed columns, so that
 //! `pd.read_parquet` and `pl.read_parquet` need no dtype arguments (`schema.rs`): unsigned integers with their
@@ -9,15 +15,19 @@
 //! the contract's number for it (`swarm_contract::mail::FROM_WORLD`, `TO_WORLD`).
 //!
 //! Parquet -> CSV gives back the world's file byte for byte (`fields.rs` spells every value as the recorder does).
-//! Both ways stream: memory holds one row group (1,048,576 rows) at most, whatever the file's size, and every
-//! output is written to a temporary file renamed into place once complete (`atomic.rs`). A malformed CSV line, a
-//! header that is not the table's, or a Parquet file that is truncated or not one of the run's tables is an
-//! [`ExportError`] naming the file and the line or row group.
+//! Both ways stream: memory holds one row group at most, whatever the file's size, and every output is written to
+//! a temporary file renamed into place once complete (`atomic.rs`). A malformed CSV line, a header that is not the
+//! table's, or a Parquet file that is truncated or not one of the run's tables is an [`ExportError`] naming the
+//! file and the line or row group.
+
+#![warn(missing_docs)]
 
 mod atomic;
 mod csv_lines;
 mod error;
 mod fields;
+mod finish;
+mod reader;
 mod schema;
 mod to_csv;
 mod to_parquet;
@@ -30,15 +40,29 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub use error::ExportError;
-use schema::Table;
+pub use fields::Value;
+pub use finish::finish_run_records;
+pub use reader::ParquetTable;
+pub use schema::{Column, Kind, Table};
 
-/// The format to export a run's records as.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+/// A format of a run's record files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
-    /// The world's CSV files, from the Parquet files.
+    /// CSV, as the world writes the files while the run goes.
     Csv,
-    /// Apache Parquet files, from the CSV files.
+    /// Apache Parquet.
+    #[default]
     Parquet,
+}
+
+impl Format {
+    /// The format converted from when converting into this one.
+    pub fn other(self) -> Format {
+        match self {
+            Format::Csv => Format::Parquet,
+            Format::Parquet => Format::Csv,
+        }
+    }
 }
 
 impl fmt::Display for Format {
@@ -105,48 +129,14 @@ pub fn export(run_dir: &Path, format: Format) -> Result<ExportReport, ExportErro
         return Err(ExportError::NoRunDir(run_dir.to_path_buf()));
     }
     let mut report = ExportReport::default();
-    let mut looked_for = Vec::new();
     for table in Table::ALL {
-        let (source_name, output_name) = match format {
-            Format::Parquet => (table.csv_name(), table.parquet_name()),
-            Format::Csv => (table.parquet_name(), table.csv_name()),
-        };
-        looked_for.push(source_name);
-        let source = run_dir.join(source_name);
-        let source_bytes = match std::fs::metadata(&source) {
-            Ok(metadata) if metadata.is_file() => metadata.len(),
-            Ok(_) => continue,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
-            Err(e) => {
-                return Err(ExportError::Io {
-                    path: source,
-                    source: e,
-                });
-            }
-        };
-        let output = run_dir.join(output_name);
-        let started = Instant::now();
-        let rows = match format {
-            Format::Parquet => to_parquet::csv_to_parquet(table, &source, &output)?,
-            Format::Csv => to_csv::parquet_to_csv(table, &source, &output)?,
-        };
-        let seconds = started.elapsed().as_secs_f64();
-        let output_bytes = std::fs::metadata(&output)
-            .map_err(|e| ExportError::Io {
-                path: output.clone(),
-                source: e,
-            })?
-            .len();
-        report.files.push(FileReport {
-            source,
-            output,
-            rows,
-            source_bytes,
-            output_bytes,
-            seconds,
-        });
+        report.files.extend(convert(run_dir, table, format)?);
     }
     if report.files.is_empty() {
+        let looked_for: Vec<&str> = Table::ALL
+            .iter()
+            .map(|table| table.file_name(format.other()))
+            .collect();
         return Err(ExportError::NoRecords {
             dir: run_dir.to_path_buf(),
             format,
@@ -154,4 +144,46 @@ pub fn export(run_dir: &Path, format: Format) -> Result<ExportReport, ExportErro
         });
     }
     Ok(report)
+}
+
+/// Converts `table`'s file of `run_dir` in the other format into `format`, beside it; `None` when the run has no
+/// such file.
+fn convert(
+    run_dir: &Path,
+    table: Table,
+    format: Format,
+) -> Result<Option<FileReport>, ExportError> {
+    let source = run_dir.join(table.file_name(format.other()));
+    let source_bytes = match std::fs::metadata(&source) {
+        Ok(metadata) if metadata.is_file() => metadata.len(),
+        Ok(_) => return Ok(None),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => {
+            return Err(ExportError::Io {
+                path: source,
+                source: e,
+            });
+        }
+    };
+    let output = run_dir.join(table.file_name(format));
+    let started = Instant::now();
+    let rows = match format {
+        Format::Parquet => to_parquet::csv_to_parquet(table, &source, &output)?,
+        Format::Csv => to_csv::parquet_to_csv(table, &source, &output)?,
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    let output_bytes = std::fs::metadata(&output)
+        .map_err(|e| ExportError::Io {
+            path: output.clone(),
+            source: e,
+        })?
+        .len();
+    Ok(Some(FileReport {
+        source,
+        output,
+        rows,
+        source_bytes,
+        output_bytes,
+        seconds,
+    }))
 }

@@ -7,11 +7,14 @@ use parquet::basic::{ConvertedType, LogicalType, Repetition, Type as PhysicalTyp
 use parquet::errors::Result as ParquetResult;
 use parquet::schema::types::{ColumnDescriptor, Type, TypePtr};
 use swarm_contract::mail::{FROM_WORLD, TO_WORLD};
-use swarm_contract::run_dir::{EVENTS_FILE, MESSAGES_FILE, TRAJECTORY_FILE};
+use swarm_contract::run_dir::{
+    EVENTS_FILE, EVENTS_PARQUET_FILE, MESSAGES_FILE, MESSAGES_PARQUET_FILE, TRAJECTORY_FILE,
+    TRAJECTORY_PARQUET_FILE,
+};
 
 /// A record table of a run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Table {
+pub enum Table {
     /// `trajectory.csv`: pose, LED and alive flag of every robot at every tick.
     Trajectory,
     /// `events.csv`: supervisor events, faults, joins and leaves.
@@ -22,7 +25,7 @@ pub(super) enum Table {
 
 /// How a column's values are spelt in CSV and stored in Parquet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Kind {
+pub enum Kind {
     /// An unsigned integer of `bits` bits (8, 16, 32 or 64): INT32 or INT64 with the unsigned logical type.
     Unsigned {
         /// 8, 16, 32 or 64.
@@ -44,7 +47,7 @@ pub(super) enum Kind {
 
 /// One column of a table.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Column {
+pub struct Column {
     /// The CSV header's name, also the Parquet column's.
     pub name: &'static str,
     /// Its values.
@@ -117,9 +120,17 @@ impl Table {
     /// The Parquet file's name in the run folder, beside the CSV file.
     pub fn parquet_name(self) -> &'static str {
         match self {
-            Table::Trajectory => "trajectory.parquet",
-            Table::Events => "events.parquet",
-            Table::Messages => "messages.parquet",
+            Table::Trajectory => TRAJECTORY_PARQUET_FILE,
+            Table::Events => EVENTS_PARQUET_FILE,
+            Table::Messages => MESSAGES_PARQUET_FILE,
+        }
+    }
+
+    /// The file's name in the run folder in `format`.
+    pub fn file_name(self, format: crate::Format) -> &'static str {
+        match format {
+            crate::Format::Csv => self.csv_name(),
+            crate::Format::Parquet => self.parquet_name(),
         }
     }
 
@@ -210,7 +221,7 @@ impl Column {
 }
 
 /// How a Parquet file's column reads in an error message, as [`Column::describe`].
-pub(super) fn describe_found(found: &ColumnDescriptor) -> String {
+pub(crate) fn describe_found(found: &ColumnDescriptor) -> String {
     let info = found.self_type().get_basic_info();
     let repetition = if info.has_repetition() {
         info.repetition()

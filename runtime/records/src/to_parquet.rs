@@ -1,9 +1,9 @@
-//! CSV -> Parquet: one row group per [`ROW_GROUP_ROWS`] rows, Snappy pages, dictionary encoding for text and
-//! integers.
+//! CSV -> Parquet: row groups of whole ticks, Snappy pages, dictionary encoding for text and integers.
 //!
-//! Parquet writes a row group column after column, so one row group's values are held in memory: converting a
-//! trajectory of 1,001,000 rows (one row group) peaked at 167 MB resident. A row group also ends early once its
-//! text reaches [`ROW_GROUP_TEXT_BYTES`], so long fields cannot grow it without bound.
+//! A row group ends at the first row of a new tick once it holds [`ROW_GROUP_ROWS`] rows, so that a reader
+//! wanting a few ticks (`swarm view`) decodes one group of about that size, found by its `tick` statistics.
+//! Parquet writes a row group column after column, so one row group's values are held in memory. A row group also
+//! ends early once its text reaches [`ROW_GROUP_TEXT_BYTES`], so long fields cannot grow it without bound.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -23,8 +23,9 @@ use super::csv_lines::CsvLines;
 use super::fields::{Value, Values};
 use super::schema::{Column, Kind, Table};
 
-/// Rows per row group.
-pub(super) const ROW_GROUP_ROWS: usize = 1 << 20;
+/// Rows after which a row group ends with its tick: 65,536 rows decode in a few milliseconds, and are large
+/// enough that pandas and polars read a file as fast as with one group (BENCHMARKS.md, "Records").
+pub(super) const ROW_GROUP_ROWS: usize = 1 << 16;
 /// Text bytes (and per-value overhead) after which a row group ends before [`ROW_GROUP_ROWS`].
 const ROW_GROUP_TEXT_BYTES: usize = 256 << 20;
 /// What a text value costs beside its bytes (the `ByteArray` and its allocation).
@@ -52,6 +53,9 @@ pub(super) fn csv_to_parquet(
     let mut group = RowGroup::new(table.columns());
     let mut rows = 0u64;
     while let Some(line) = lines.next_line()? {
+        if group.rows >= ROW_GROUP_ROWS && group.last_tick() != tick_field(line) {
+            writer.write(&mut group)?;
+        }
         let added = group.push_line(line);
         added.map_err(|what| lines.error(what))?;
         rows += 1;
@@ -65,6 +69,17 @@ pub(super) fn csv_to_parquet(
     let file = writer.finish()?;
     atomic.commit(file)?;
     Ok(rows)
+}
+
+/// The `tick` field of a CSV line (its first), as stored; `None` when it is not a number (the line is then
+/// refused when added).
+fn tick_field(line: &[u8]) -> Option<i64> {
+    let field = line.split(|&b| b == b',').next()?;
+    std::str::from_utf8(field)
+        .ok()?
+        .parse::<u64>()
+        .ok()
+        .map(|tick| tick as i64)
 }
 
 /// The Parquet file being written, errors naming it.
@@ -185,8 +200,17 @@ impl RowGroup {
         Ok(())
     }
 
+    /// Whether the row group must end now, whatever the next row's tick.
     fn is_full(&self) -> bool {
-        self.rows >= ROW_GROUP_ROWS || self.text_bytes >= ROW_GROUP_TEXT_BYTES
+        self.text_bytes >= ROW_GROUP_TEXT_BYTES
+    }
+
+    /// The `tick` of the last row added (every table's first column).
+    fn last_tick(&self) -> Option<i64> {
+        match self.columns.first().map(|c| &c.values) {
+            Some(Values::Int64(ticks)) => ticks.last().copied(),
+            _ => None,
+        }
     }
 
     fn clear(&mut self) {

@@ -1,13 +1,12 @@
-//! Parquet -> CSV: the world's CSV again, byte for byte, read [`BATCH_ROWS`] rows at a time from every column of a
-//! row group.
+//! Reading a Parquet file of one of the run's tables, row group by row group: `swarm export --format csv` turns
+//! the rows into CSV lines, `swarm view` into poses and events.
 //!
 //! Only Parquet files of the run's own tables are read: a file whose columns are not exactly the table's (names,
-//! types, nullability) is refused before anything is written. The parquet crate can panic on some malformed pages
-//! (a dictionary-encoded page without its dictionary), so the reading runs under `catch_unwind` and such a panic
+//! types, nullability) is refused when opened. The parquet crate can panic on some malformed pages (a
+//! dictionary-encoded page without its dictionary), so every read runs under `catch_unwind` and such a panic
 //! becomes an error naming the file and row group (the panic's own message still reaches standard error).
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -17,71 +16,111 @@ use parquet::errors::ParquetError;
 use parquet::file::metadata::RowGroupMetaData;
 use parquet::file::reader::{FileReader, RowGroupReader};
 use parquet::file::serialized_reader::SerializedFileReader;
+use parquet::file::statistics::Statistics;
 
-use super::ExportError;
-use super::atomic::AtomicFile;
-use super::fields::{Value, Values};
-use super::schema::{Column, Table, describe_found};
+use crate::ExportError;
+use crate::fields::{Value, Values};
+use crate::schema::{Column, Table, describe_found};
 
 /// Rows read from each column at a time.
 const BATCH_ROWS: usize = 1 << 14;
+/// Columns of the widest table (the trajectory's ten).
+const MAX_COLUMNS: usize = 16;
 
-/// Converts the Parquet file `source` of `table` into the CSV file `output`; returns the rows converted.
-pub(super) fn parquet_to_csv(
+/// An open Parquet file of one of the run's tables, its schema checked.
+pub struct ParquetTable {
     table: Table,
-    source: &Path,
-    output: &Path,
-) -> Result<u64, ExportError> {
-    let file_error = |what: String| ExportError::Parquet {
-        path: source.to_path_buf(),
-        what,
-    };
-    let io = |e| ExportError::Io {
-        path: source.to_path_buf(),
-        source: e,
-    };
-    let file = File::open(source).map_err(io)?;
-    let file_bytes = file.metadata().map_err(io)?.len();
-    let reader = unpanicked(
-        || {
-            let reader = SerializedFileReader::new(file)
-                .map_err(|e| file_error(format!("not a readable Parquet file: {e}")))?;
-            check_schema(table, &reader).map_err(file_error)?;
-            Ok(reader)
-        },
-        file_error,
-    )?;
+    path: PathBuf,
+    reader: SerializedFileReader<File>,
+    file_bytes: u64,
+}
 
-    let (atomic, file) = AtomicFile::create(output)?;
-    let mut out = CsvOut {
-        out: BufWriter::with_capacity(1 << 16, file),
-        line: Vec::new(),
-        path: atomic.path().to_path_buf(),
-    };
-    out.line.extend_from_slice(table.header().as_bytes());
-    out.end_line()?;
-    let mut rows = 0u64;
-    for index in 0..reader.num_row_groups() {
-        let group_error = |what: String| ExportError::RowGroup {
-            path: source.to_path_buf(),
+impl ParquetTable {
+    /// Opens the Parquet file at `path` as `table`: its footer is read and its columns compared with the table's.
+    pub fn open(table: Table, path: &Path) -> Result<ParquetTable, ExportError> {
+        let file_error = |what: String| ExportError::Parquet {
+            path: path.to_path_buf(),
+            what,
+        };
+        let io = |e| ExportError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        };
+        let file = File::open(path).map_err(io)?;
+        let file_bytes = file.metadata().map_err(io)?.len();
+        let reader = unpanicked(
+            || {
+                let reader = SerializedFileReader::new(file)
+                    .map_err(|e| file_error(format!("not a readable Parquet file: {e}")))?;
+                check_schema(table, &reader).map_err(file_error)?;
+                Ok(reader)
+            },
+            file_error,
+        )?;
+        Ok(ParquetTable {
+            table,
+            path: path.to_path_buf(),
+            reader,
+            file_bytes,
+        })
+    }
+
+    /// The table the file holds.
+    pub fn table(&self) -> Table {
+        self.table
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Row groups in the file.
+    pub fn row_groups(&self) -> usize {
+        self.reader.num_row_groups()
+    }
+
+    /// Rows of row group `index`, as its metadata says.
+    pub fn rows(&self, index: usize) -> u64 {
+        u64::try_from(self.reader.metadata().row_group(index).num_rows()).unwrap_or(0)
+    }
+
+    /// The first and last `tick` of row group `index`, from its statistics (the writer keeps them; `None` when
+    /// a file has none).
+    pub fn ticks(&self, index: usize) -> Option<(u64, u64)> {
+        let chunk = self.reader.metadata().row_group(index).columns().first()?;
+        match chunk.statistics()? {
+            Statistics::Int64(s) => Some((*s.min_opt()? as u64, *s.max_opt()? as u64)),
+            _ => None,
+        }
+    }
+
+    /// Reads row group `index`, handing each row's values (in column order; nulls as [`Value::Null`]) to `row`
+    /// with its number in the group; returns the rows read. An error of `row` ends the reading and is reported
+    /// with the row group and row.
+    pub fn read_row_group(
+        &self,
+        index: usize,
+        mut row: impl FnMut(u64, &[Value<'_>]) -> Result<(), String>,
+    ) -> Result<u64, ExportError> {
+        let error = |what: String| ExportError::RowGroup {
+            path: self.path.clone(),
             row_group: index,
             what,
         };
-        let converted = || {
-            check_chunks(reader.metadata().row_group(index), file_bytes).map_err(group_error)?;
-            let group = reader
-                .get_row_group(index)
-                .map_err(|e| group_error(e.to_string()))?;
-            convert_row_group(table.columns(), group.as_ref(), &mut out, group_error)
-        };
-        rows += unpanicked(converted, group_error)?;
+        unpanicked(
+            || {
+                check_chunks(self.reader.metadata().row_group(index), self.file_bytes)
+                    .map_err(error)?;
+                let group = self
+                    .reader
+                    .get_row_group(index)
+                    .map_err(|e| error(e.to_string()))?;
+                read_rows(self.table.columns(), group.as_ref(), &mut row).map_err(error)
+            },
+            error,
+        )
     }
-    let file = out.out.into_inner().map_err(|e| ExportError::Io {
-        path: out.path.clone(),
-        source: e.into_error(),
-    })?;
-    atomic.commit(file)?;
-    Ok(rows)
 }
 
 /// Runs `read`, turning a panic of the parquet crate into `error`'s.
@@ -147,36 +186,20 @@ fn check_chunks(group: &RowGroupMetaData, file_bytes: u64) -> Result<(), String>
     Ok(())
 }
 
-/// The CSV file being written, errors naming it.
-struct CsvOut {
-    out: BufWriter<File>,
-    /// The line being formatted.
-    line: Vec<u8>,
-    path: PathBuf,
-}
-
-impl CsvOut {
-    /// Writes the line formatted in `line` and a line end.
-    fn end_line(&mut self) -> Result<(), ExportError> {
-        self.line.push(b'\n');
-        self.out
-            .write_all(&self.line)
-            .map_err(|source| ExportError::Io {
-                path: self.path.clone(),
-                source,
-            })
-    }
-}
-
-/// Writes one row group's rows; returns how many. `error` names the row group.
-fn convert_row_group(
+/// Hands one row group's rows to `row`; returns how many.
+fn read_rows(
     columns: &[Column],
     group: &dyn RowGroupReader,
-    out: &mut CsvOut,
-    error: impl Fn(String) -> ExportError,
-) -> Result<u64, ExportError> {
+    row: &mut impl FnMut(u64, &[Value<'_>]) -> Result<(), String>,
+) -> Result<u64, String> {
+    if columns.len() > MAX_COLUMNS {
+        return Err(format!(
+            "{} columns, more than {MAX_COLUMNS}",
+            columns.len()
+        ));
+    }
     let claimed = group.metadata().num_rows();
-    let expected = u64::try_from(claimed).map_err(|_| error(format!("{claimed} rows")))?;
+    let expected = u64::try_from(claimed).map_err(|_| format!("{claimed} rows"))?;
     let mut cursors = columns
         .iter()
         .enumerate()
@@ -184,15 +207,14 @@ fn convert_row_group(
             let reader = group.get_column_reader(index).map_err(|e| e.to_string())?;
             ColumnCursor::new(column, reader)
         })
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(&error)?;
+        .collect::<Result<Vec<_>, String>>()?;
     let mut rows = 0u64;
+    let mut places = [None; MAX_COLUMNS];
     loop {
         let counts = cursors
             .iter_mut()
             .map(ColumnCursor::read_batch)
-            .collect::<Result<Vec<usize>, String>>()
-            .map_err(&error)?;
+            .collect::<Result<Vec<usize>, String>>()?;
         let batch = counts.first().copied().unwrap_or_default();
         if let Some(odd) = counts.iter().position(|&count| count != batch) {
             let (short, long) = if counts[odd] < batch {
@@ -200,40 +222,33 @@ fn convert_row_group(
             } else {
                 (0, odd)
             };
-            return Err(error(format!(
+            return Err(format!(
                 "column `{}` has fewer rows than column `{}`",
                 columns[short].name, columns[long].name
-            )));
+            ));
         }
         if batch == 0 {
             break;
         }
-        for row in 0..batch {
-            out.line.clear();
-            for (index, cursor) in cursors.iter_mut().enumerate() {
-                if index > 0 {
-                    out.line.push(b',');
-                }
-                let column = cursor.column;
-                let formatted = cursor
-                    .value(row)
-                    .and_then(|value| column.format(value, &mut out.line));
-                formatted.map_err(|e| {
-                    error(format!(
-                        "row {}, column `{}`: {e}",
-                        rows + row as u64,
-                        column.name
-                    ))
-                })?;
+        for in_batch in 0..batch {
+            for (place, cursor) in places.iter_mut().zip(cursors.iter_mut()) {
+                *place = cursor.next_place(in_batch);
             }
-            out.end_line()?;
+            let mut values = [Value::Null; MAX_COLUMNS];
+            for (index, cursor) in cursors.iter().enumerate() {
+                if let Some(place) = places[index] {
+                    values[index] = cursor.values.get(place).ok_or_else(|| {
+                        format!("column `{}` has fewer values than rows", cursor.column.name)
+                    })?;
+                }
+            }
+            let number = rows + in_batch as u64;
+            row(number, &values[..columns.len()]).map_err(|e| format!("row {number}, {e}"))?;
         }
         rows += batch as u64;
     }
     if rows != expected {
-        return Err(error(format!(
-            "{rows} rows where its metadata says {expected}"
-        )));
+        return Err(format!("{rows} rows where its metadata says {expected}"));
     }
     Ok(rows)
 }
@@ -306,20 +321,16 @@ impl ColumnCursor {
         read.map_err(|e| format!("column `{}`: {e}", self.column.name))
     }
 
-    /// The value of row `row` of the batch; rows are asked for in order.
-    fn value(&mut self, row: usize) -> Result<Value<'_>, String> {
+    /// Where in `values` row `in_batch` of the batch is, `None` for a null; rows are asked for in order.
+    fn next_place(&mut self, in_batch: usize) -> Option<usize> {
         let present = match &self.levels {
-            Some(levels) => levels.get(row).is_some_and(|&level| level > 0),
+            Some(levels) => levels.get(in_batch).is_some_and(|&level| level > 0),
             None => true,
         };
-        if !present {
-            return Ok(Value::Null);
-        }
-        let index = self.next_value;
-        self.next_value += 1;
-        self.values
-            .get(index)
-            .ok_or_else(|| format!("column `{}` has fewer values than rows", self.column.name))
+        present.then(|| {
+            self.next_value += 1;
+            self.next_value - 1
+        })
     }
 }
 

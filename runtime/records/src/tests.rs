@@ -5,8 +5,8 @@ use parquet::basic::{ConvertedType, Encoding, Type as PhysicalType};
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::record::{Field, RowAccessor};
 
-use super::schema::Table;
-use super::{ExportError, Format, export};
+use super::to_parquet::ROW_GROUP_ROWS;
+use super::{ExportError, Format, ParquetTable, Table, Value, export, finish_run_records};
 
 /// Rows as the world writes them (`ryu`'s forms): NaN poses, an exponent, -0.0, LED bytes, an empty robot id.
 const TRAJECTORY: &str = "tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive
@@ -381,30 +381,81 @@ fn a_missing_or_empty_run_folder_is_an_error() {
 }
 
 #[test]
-fn a_row_group_holds_at_most_a_million_rows() {
-    let rows = super::to_parquet::ROW_GROUP_ROWS + 3;
+fn row_groups_end_with_the_tick_that_fills_them_and_know_their_ticks() {
+    const PER_TICK: usize = 100;
+    let rows = ROW_GROUP_ROWS + 250;
     let mut csv = String::from("tick,robot,robot_id,event\n");
     for row in 0..rows {
-        csv += &format!("{},{},e{},Go\n", row / 100, row % 100, row % 100);
+        csv += &format!(
+            "{},{},e{},Go\n",
+            row / PER_TICK,
+            row % PER_TICK,
+            row % PER_TICK
+        );
     }
     let run = run_with(&[("events.csv", &csv)]);
     export(run.path(), Format::Parquet).expect("exported");
-    let reader = SerializedFileReader::try_from(run.path().join("events.parquet").as_path())
-        .expect("a Parquet file");
-    let groups: Vec<i64> = reader
-        .metadata()
-        .row_groups()
-        .iter()
-        .map(|g| g.num_rows())
-        .collect();
-    assert_eq!(groups, [super::to_parquet::ROW_GROUP_ROWS as i64, 3]);
+    let table = ParquetTable::open(Table::Events, &run.path().join("events.parquet"))
+        .expect("a Parquet file of the table");
+    let first = ROW_GROUP_ROWS.div_ceil(PER_TICK) * PER_TICK;
+    let groups: Vec<u64> = (0..table.row_groups()).map(|g| table.rows(g)).collect();
+    assert_eq!(groups, [first as u64, (rows - first) as u64]);
+    let last_tick = ((rows - 1) / PER_TICK) as u64;
+    let first_group_end = (first / PER_TICK - 1) as u64;
+    assert_eq!(table.ticks(0), Some((0, first_group_end)));
+    assert_eq!(table.ticks(1), Some((first_group_end + 1, last_tick)));
+    let mut seen = Vec::new();
+    table
+        .read_row_group(1, |row, values| {
+            seen.push((row, format!("{:?} {:?}", values[0], values[1])));
+            Ok(())
+        })
+        .expect("read");
+    assert_eq!(seen.len(), rows - first);
+    let expected = (Value::Int64(first_group_end as i64 + 1), Value::Int32(0));
+    assert_eq!(seen[0], (0, format!("{:?} {:?}", expected.0, expected.1)));
     fs::remove_file(run.path().join("events.csv")).expect("removed");
     export(run.path(), Format::Csv).expect("exported back");
     assert!(fs::read_to_string(run.path().join("events.csv")).expect("read") == csv);
 }
 
+#[test]
+fn finishing_a_run_leaves_parquet_files_only() {
+    let run = all_tables();
+    let csv: Vec<Vec<u8>> = Table::ALL
+        .iter()
+        .map(|t| fs::read(run.path().join(t.csv_name())).expect("read"))
+        .collect();
+    let report = finish_run_records(run.path()).expect("finished");
+    assert_eq!(report.files.len(), 3);
+    assert_eq!(
+        names_in(run.path()),
+        ["events.parquet", "messages.parquet", "trajectory.parquet"]
+    );
+    export(run.path(), Format::Csv).expect("exported back");
+    for (table, original) in Table::ALL.iter().zip(&csv) {
+        assert!(&fs::read(run.path().join(table.csv_name())).expect("read") == original);
+    }
+}
+
+#[test]
+fn a_run_whose_records_cannot_be_finished_keeps_its_csv_files_alone() {
+    let run = all_tables();
+    fs::write(
+        run.path().join("events.csv"),
+        "tick,robot,robot_id,event\n1,x,e0,Go\n",
+    )
+    .expect("written");
+    let error = finish_run_records(run.path()).expect_err("a malformed row");
+    assert!(error.to_string().contains("events.csv, line 2"), "{error}");
+    assert_eq!(
+        names_in(run.path()),
+        ["events.csv", "messages.csv", "trajectory.csv"]
+    );
+}
+
 /// Converts a real run both ways and prints sizes and times: `SWARM_EXPORT_BENCH_DIR=<run folder> cargo test
-/// -p swarm-cli --release export::tests::export_a_real_run -- --ignored --nocapture`. The run folder is not
+/// -p swarm-records --release tests::export_a_real_run -- --ignored --nocapture`. The run folder is not
 /// touched: its CSV files are copied into a temporary folder first.
 #[test]
 #[ignore = "needs SWARM_EXPORT_BENCH_DIR, a run folder"]
