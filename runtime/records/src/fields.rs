@@ -23,7 +23,42 @@ pub enum Value<'a> {
     Null,
 }
 
+/// A field as a program writes it into a CSV line (the world's recorder), before it is a column's value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Field<'a> {
+    /// An unsigned integer, written by `itoa`.
+    Int(u64),
+    /// A float, written in `ryu`'s shortest round-trip form.
+    Float(f32),
+    /// Text, written as is.
+    Text(&'a str),
+}
+
 impl Column {
+    /// The value `field` stands for in this column: what [`Column::parse`] reads back from the CSV text the
+    /// recorder writes for it, found without the text (so a `NaN` of any sign or payload is the one `NaN` that
+    /// `"NaN"` reads as).
+    pub fn value_of(self, field: Field<'_>) -> Result<Value<'_>, String> {
+        let value = match (self.kind, field) {
+            (_, Field::Text("")) if self.optional => Value::Null,
+            (Kind::Unsigned { bits: 64 }, Field::Int(v)) => Value::Int64(v as i64),
+            (Kind::Unsigned { bits }, Field::Int(v)) if v >> bits == 0 => {
+                Value::Int32(v as u32 as i32)
+            }
+            (Kind::Participant { world }, Field::Int(v))
+                if v != u64::from(world) && v <= u64::from(u32::MAX) =>
+            {
+                Value::Int32(v as u32 as i32)
+            }
+            (Kind::Participant { world }, Field::Text("world")) => Value::Int32(world as i32),
+            (Kind::Float, Field::Float(v)) => Value::Float(if v.is_nan() { f32::NAN } else { v }),
+            (Kind::Flag, Field::Int(v @ (0 | 1))) => Value::Boolean(v == 1),
+            (Kind::Text, Field::Text(text)) => Value::Text(text.as_bytes()),
+            (_, field) => return Err(format!("{field:?} is not a value of this column")),
+        };
+        Ok(value)
+    }
+
     /// Reads one CSV field of this column.
     pub fn parse(self, field: &[u8]) -> Result<Value<'_>, String> {
         if self.optional && field.is_empty() {

@@ -31,6 +31,7 @@ mod reader;
 mod schema;
 mod to_csv;
 mod to_parquet;
+mod writer;
 
 #[cfg(test)]
 mod tests;
@@ -40,10 +41,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub use error::ExportError;
-pub use fields::Value;
+pub use fields::{Field, Value};
 pub use finish::finish_run_records;
 pub use reader::ParquetTable;
 pub use schema::{Column, Kind, Table};
+pub use writer::{MAX_COLUMNS, TableWriter};
 
 /// A format of a run's record files.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]

@@ -21,11 +21,10 @@ use parquet::file::statistics::Statistics;
 use crate::ExportError;
 use crate::fields::{Value, Values};
 use crate::schema::{Column, Table, describe_found};
+use crate::writer::MAX_COLUMNS;
 
 /// Rows read from each column at a time.
 const BATCH_ROWS: usize = 1 << 14;
-/// Columns of the widest table (the trajectory's ten).
-const MAX_COLUMNS: usize = 16;
 
 /// An open Parquet file of one of the run's tables, its schema checked.
 pub struct ParquetTable {

@@ -24,11 +24,18 @@ pub trait RowWriter: Send + 'static {
 
     /// Formats and writes `rows`, then flushes the file.
     fn write_batch(&mut self, rows: &[Self::Row]) -> Result<(), WorldError>;
+
+    /// Completes the files once the last batch is written ([`Background::finish`]; a handle dropped without it
+    /// leaves them as they are).
+    fn close(&mut self) -> Result<(), WorldError> {
+        Ok(())
+    }
 }
 
 enum Order<R> {
     Write(Vec<R>),
     Sync(mpsc::Sender<()>),
+    Close,
 }
 
 /// The tick loop's handle on a file written by a background thread.
@@ -59,6 +66,7 @@ impl<W: RowWriter> Background<W> {
                         Order::Sync(done) => {
                             let _ = done.send(());
                         }
+                        Order::Close => writer.close()?,
                     }
                 }
                 Ok(())
@@ -102,9 +110,11 @@ impl<W: RowWriter> Background<W> {
         }
     }
 
-    /// Hands over the current batch, lets the thread write everything and waits for it to end.
+    /// Hands over the current batch, lets the thread write everything, complete the files and end, and waits
+    /// for it.
     pub fn finish(mut self) -> Result<(), WorldError> {
         self.end_batch()?;
+        self.send(Order::Close)?;
         self.orders = None;
         match self.thread.take().map(JoinHandle::join) {
             Some(Ok(written)) => written,

@@ -52,6 +52,7 @@ impl EventsWriter {
         dir: &Path,
         arena: &Arena,
         coordinators: &[Coordinator],
+        parquet: bool,
     ) -> Result<EventsWriter, WorldError> {
         let tables_path = dir.join(EVENT_TABLES_FILE);
         let tables: BTreeMap<String, Vec<String>> = match std::fs::read_to_string(&tables_path) {
@@ -61,7 +62,12 @@ impl EventsWriter {
             })?,
             Err(_) => BTreeMap::new(),
         };
-        let file = CsvFile::create(&dir.join(EVENTS_FILE), "tick,robot,robot_id,event", 1 << 13)?;
+        let file = CsvFile::create(
+            &dir.join(EVENTS_FILE),
+            "tick,robot,robot_id,event",
+            1 << 13,
+            parquet.then_some(swarm_records::Table::Events),
+        )?;
         let named = |id: &str, controller: &str| {
             (
                 id.to_owned(),
@@ -85,6 +91,11 @@ impl EventsWriter {
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
         self.file.flush()
+    }
+
+    /// Flushes the file and completes its Parquet file.
+    pub fn close(&mut self) -> Result<(), WorldError> {
+        self.file.close()
     }
 
     fn format(&mut self, row: &EventRow) -> std::io::Result<()> {

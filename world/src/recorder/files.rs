@@ -67,4 +67,15 @@ impl RowWriter for RecordFiles {
         }
         self.trajectory.flush()
     }
+
+    fn close(&mut self) -> Result<(), WorldError> {
+        self.events.close()?;
+        if let Some(messages) = &mut self.messages {
+            messages.close()?;
+        }
+        if let Some(objects) = &mut self.objects {
+            objects.flush()?;
+        }
+        self.trajectory.close()
+    }
 }

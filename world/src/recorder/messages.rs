@@ -16,12 +16,13 @@ pub struct MessagesWriter {
 }
 
 impl MessagesWriter {
-    /// Creates `messages.csv` in `dir` with its header line.
-    pub fn create(dir: &Path) -> Result<MessagesWriter, WorldError> {
+    /// Creates `messages.csv` in `dir` with its header line; with `parquet`, also the table's Parquet file.
+    pub fn create(dir: &Path, parquet: bool) -> Result<MessagesWriter, WorldError> {
         let file = CsvFile::create(
             &dir.join(MESSAGES_FILE),
             "tick,from,to,address,bytes,outcome,reason",
             1 << 13,
+            parquet.then_some(swarm_records::Table::Messages),
         )?;
         Ok(MessagesWriter { file })
     }
@@ -34,6 +35,11 @@ impl MessagesWriter {
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
         self.file.flush()
+    }
+
+    /// Flushes the file and completes its Parquet file.
+    pub fn close(&mut self) -> Result<(), WorldError> {
+        self.file.close()
     }
 
     fn format(&mut self, row: &MessageRecord) -> std::io::Result<()> {

@@ -11,6 +11,7 @@ pub mod events;
 pub mod files;
 pub mod messages;
 pub mod objects_file;
+mod parquet_twin;
 pub mod pheromone_file;
 pub mod scene_file;
 pub mod snapshot;
@@ -72,8 +73,14 @@ impl Recorder {
     /// Creates `dir` (if needed) and its `trajectory.csv` and `events.csv` for `world`'s robots (event names
     /// from the launcher's event tables in `dir`, if any); snapshots are drawn after each tick in
     /// `snapshot_ticks` (tick 0 is the initial placement: record it before the first tick), and of the final
-    /// state by [`Recorder::finish`].
-    pub fn create(dir: &Path, world: &World, snapshot_ticks: &[u64]) -> Result<Self, WorldError> {
+    /// state by [`Recorder::finish`]. With `parquet`, the record tables are also written as Parquet files, which
+    /// [`Recorder::finish`] completes.
+    pub fn create(
+        dir: &Path,
+        world: &World,
+        snapshot_ticks: &[u64],
+        parquet: bool,
+    ) -> Result<Self, WorldError> {
         std::fs::create_dir_all(dir).map_err(|source| WorldError::Io {
             path: dir.to_path_buf(),
             source,
@@ -81,11 +88,15 @@ impl Recorder {
         let (object_moves, objects) =
             objects_file::ObjectsWriter::create(dir, &world.arena)?.unzip();
         let files = RecordFiles {
-            events: EventsWriter::create(dir, &world.arena, world.coordinators())?,
-            trajectory: TrajectoryWriter::create(&dir.join(TRAJECTORY_FILE), &world.arena)?,
+            events: EventsWriter::create(dir, &world.arena, world.coordinators(), parquet)?,
+            trajectory: TrajectoryWriter::create(
+                &dir.join(TRAJECTORY_FILE),
+                &world.arena,
+                parquet,
+            )?,
             messages: world
                 .has_mail()
-                .then(|| messages::MessagesWriter::create(dir))
+                .then(|| messages::MessagesWriter::create(dir, parquet))
                 .transpose()?,
             objects,
         };

@@ -62,10 +62,12 @@ pub struct TrajectoryWriter {
 }
 
 impl TrajectoryWriter {
-    /// Creates (truncates) the file for the arena's robots and writes the header.
-    pub fn create(path: &Path, arena: &Arena) -> Result<Self, WorldError> {
+    /// Creates (truncates) the file for the arena's robots and writes the header; with `parquet`, also the
+    /// table's Parquet file.
+    pub fn create(path: &Path, arena: &Arena, parquet: bool) -> Result<Self, WorldError> {
+        let twin = parquet.then_some(swarm_records::Table::Trajectory);
         Ok(Self {
-            file: CsvFile::create(path, TRAJECTORY_HEADER, 1 << 16)?,
+            file: CsvFile::create(path, TRAJECTORY_HEADER, 1 << 16, twin)?,
             names: arena.robots.iter().map(|r| r.name.clone()).collect(),
         })
     }
@@ -78,6 +80,11 @@ impl TrajectoryWriter {
     /// Writes the buffer to the file.
     pub fn flush(&mut self) -> Result<(), WorldError> {
         self.file.flush()
+    }
+
+    /// Flushes the file and completes its Parquet file.
+    pub fn close(&mut self) -> Result<(), WorldError> {
+        self.file.close()
     }
 
     fn format(&mut self, row: &PoseRow) -> std::io::Result<()> {

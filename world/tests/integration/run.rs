@@ -17,7 +17,7 @@ fn recorded_run(seed: u64, ticks: u64, dir: &std::path::Path) -> Vec<u8> {
     exp.controllers[0].sensors[0].noise_level = 0.02;
     exp.controllers[0].actuators[0].noise_std_dev = 0.05;
     let mut world = World::new(&exp, seed).expect("builds");
-    let mut recorder = Recorder::create(dir, &world, &[]).expect("recorder");
+    let mut recorder = Recorder::create(dir, &world, &[], false).expect("recorder");
     recorder.record(&mut world).expect("record");
     for _ in 0..ticks {
         world.run_in_process(1, avoid_obstacles);
@@ -64,7 +64,7 @@ fn recorder_writes_summary_metrics_and_png_snapshots_of_the_start_and_the_final_
         location: crate::common::config::at(20),
     });
     let mut world = World::new(&exp, 7).expect("builds");
-    let mut recorder = Recorder::create(dir.path(), &world, &[0]).expect("recorder");
+    let mut recorder = Recorder::create(dir.path(), &world, &[0], false).expect("recorder");
     recorder.record(&mut world).expect("record");
     for _ in 0..20 {
         world.run_in_process(1, avoid_obstacles);
@@ -86,6 +86,56 @@ fn recorder_writes_summary_metrics_and_png_snapshots_of_the_start_and_the_final_
         let png = std::fs::read(dir.path().join(format!("snapshot_{tick}.png")))
             .expect("snapshot written");
         assert_eq!(&png[1..4], b"PNG");
+    }
+}
+
+#[test]
+fn a_finished_recorder_completes_the_parquet_tables_and_an_unfinished_one_leaves_none() {
+    let exp = thesis_example();
+    for finished in [true, false] {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut world = World::new(&exp, 3).expect("builds");
+        let mut recorder = Recorder::create(dir.path(), &world, &[], true).expect("recorder");
+        recorder.record(&mut world).expect("record");
+        for _ in 0..30 {
+            world.run_in_process(1, avoid_obstacles);
+            recorder.record(&mut world).expect("record");
+        }
+        if finished {
+            recorder
+                .finish(&world, serde_json::json!({}))
+                .expect("summary");
+        } else {
+            // A tick loop that returned early: its rows reach the CSV file, its Parquet file is not completed.
+            drop(recorder);
+        }
+        let parquet = dir.path().join("trajectory.parquet");
+        let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).expect("CSV");
+        assert_eq!(csv.lines().count(), 1 + 40 * 31);
+        if !finished {
+            let names: Vec<String> = std::fs::read_dir(dir.path())
+                .expect("listed")
+                .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+                .filter(|name| name.contains("parquet"))
+                .collect();
+            assert_eq!(
+                names,
+                Vec::<String>::new(),
+                "no Parquet file, not even a temporary one"
+            );
+            continue;
+        }
+        let table = swarm_records::ParquetTable::open(swarm_records::Table::Trajectory, &parquet)
+            .expect("a complete Parquet trajectory");
+        assert_eq!(table.ticks(0), Some((0, 30)));
+        assert_eq!(table.rows(0), 40 * 31);
+        assert!(
+            swarm_records::ParquetTable::open(
+                swarm_records::Table::Events,
+                &dir.path().join("events.parquet")
+            )
+            .is_ok()
+        );
     }
 }
 

@@ -373,6 +373,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         limits: options.limits.clone(),
         real_time: options.real_time,
         faults: options.faults.clone(),
+        records_csv: options.records == swarm_records::Format::Csv,
     };
     let mut world = children::spawn(
         Command::new(&binaries.world)

@@ -48,6 +48,10 @@ pub struct WorldArgs {
     /// Faults given on the command line (`swarm run --fault`), added to the configuration's `<faults>`.
     #[arg(long = "fault")]
     pub faults: Vec<String>,
+    /// Write the record tables as CSV only (`swarm run --records csv`); by default each is also written as
+    /// Parquet, completed when the run ends normally.
+    #[arg(long = "records-csv")]
+    pub records_csv: bool,
 }
 
 impl WorldArgs {
@@ -75,6 +79,9 @@ impl WorldArgs {
         }
         for fault in &self.faults {
             args.extend(["--fault".into(), fault.clone()]);
+        }
+        if self.records_csv {
+            args.push("--records-csv".into());
         }
         args
     }
@@ -224,6 +231,7 @@ mod tests {
             limits: vec!["tick_deadline_ms=250".into(), "join_timeout_ms=5000".into()],
             real_time: true,
             faults: vec!["kill robots=3 tick=50".into()],
+            records_csv: true,
         };
         let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
         assert_eq!(World::parse_from(line).args, args);
