@@ -2,10 +2,11 @@
 //! them in, and the conversions between them.
 //!
 //! The world writes the tables as CSV while the run goes (`world/src/recorder/`): appended tick by tick, so that a
-//! run cut short keeps every whole tick and `swarm run --view` can follow the files. When the run ends, the
-//! launcher turns them into Apache Parquet and removes the CSV files ([`finish_run_records`]), unless the run was
-//! asked for CSV (`swarm run --records csv`). `swarm export` converts either way ([`export`]); `swarm view` reads
-//! the Parquet files row group by row group ([`ParquetTable`]).
+//! run cut short keeps every whole tick and `swarm run --view` can follow the files. It hands the same fields to a
+//! [`TableWriter`] per table, whose Parquet file it completes when the run ends normally. The launcher then
+//! removes the CSV files, converting first any table the world could not complete ([`finish_run_records`]),
+//! unless the run was asked for CSV (`swarm run --records csv`). `swarm export` converts either way
+//! ([`export`]); `swarm view` reads the Parquet files row group by row group ([`ParquetTable`]).
 //!
 //! The Parquet files keep the CSV columns, names and order (docs/records.md) with typed columns, so that
 //! `pd.read_parquet` and `pl.read_parquet` need no dtype arguments (`schema.rs`): unsigned integers with their
