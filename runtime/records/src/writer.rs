@@ -9,15 +9,17 @@
 //! file is written under a temporary name and renamed into place by [`TableWriter::finish`]; a writer dropped
 //! unfinished removes it.
 
+use std::collections::HashMap;
 use std::fs::File;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use parquet::basic::Compression;
 use parquet::column::writer::{ColumnWriter, ColumnWriterImpl};
-use parquet::data_type::DataType;
+use parquet::data_type::{ByteArray, DataType};
 use parquet::errors::ParquetError;
-use parquet::file::properties::WriterProperties;
+use parquet::file::properties::{EnabledStatistics, WriterProperties};
 use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::ColumnPath;
 
@@ -104,6 +106,10 @@ impl ParquetOut {
             .fold(WriterProperties::builder(), |builder, column| {
                 builder.set_column_dictionary_enabled(ColumnPath::from(column.name), false)
             })
+            // Statistics cost a comparison per value; only `tick`'s are read (to find a tick's row group, by
+            // `swarm view`, and by pandas and polars to skip groups when filtering on ticks).
+            .set_statistics_enabled(EnabledStatistics::None)
+            .set_column_statistics_enabled(ColumnPath::from("tick"), EnabledStatistics::Chunk)
             .set_compression(Compression::SNAPPY)
             .build();
         let writer = table
@@ -161,6 +167,51 @@ struct ColumnValues {
     values: Values,
     /// Definition levels of an optional column: 1 for a value, 0 for a null.
     levels: Option<Vec<i16>>,
+    /// Text values seen before, shared rather than copied.
+    interned: Interned,
+}
+
+/// Text values a column has held, each kept once: robot ids, event names and message outcomes repeat on nearly
+/// every row, and copying each into an allocation of its own was a third of the world's recording thread.
+#[derive(Default)]
+struct Interned(HashMap<Vec<u8>, ByteArray, BuildHasherDefault<Fnv1a>>);
+
+/// FNV-1a: the keys are a few bytes long and come from the run itself, so the default hasher's resistance to
+/// chosen keys buys nothing, and its cost per lookup was most of the interning's.
+struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Fnv1a(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Hasher for Fnv1a {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &byte in bytes {
+            self.0 = (self.0 ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+}
+
+/// Distinct text values kept per column at most; further ones are copied.
+const MAX_INTERNED: usize = 1 << 16;
+
+impl Interned {
+    fn get(&mut self, text: &[u8]) -> ByteArray {
+        if let Some(value) = self.0.get(text) {
+            return value.clone();
+        }
+        let value = ByteArray::from(text.to_vec());
+        if self.0.len() < MAX_INTERNED {
+            self.0.insert(text.to_vec(), value.clone());
+        }
+        value
+    }
 }
 
 impl RowGroup {
@@ -171,6 +222,7 @@ impl RowGroup {
                 column,
                 values: Values::new(column.kind),
                 levels: column.optional.then(Vec::new),
+                interned: Interned::default(),
             })
             .collect();
         RowGroup {
@@ -234,7 +286,13 @@ impl ColumnValues {
         if let Some(levels) = &mut self.levels {
             levels.push(i16::from(value != Value::Null));
         }
-        self.values.push(value)
+        match (&mut self.values, value) {
+            (Values::Text(values), Value::Text(text)) => {
+                values.push(self.interned.get(text));
+                Ok(())
+            }
+            (values, value) => values.push(value),
+        }
     }
 
     fn write(&self, writer: &mut ColumnWriter<'_>) -> Result<(), ParquetError> {
