@@ -527,6 +527,43 @@ fn ticks_make_a_run_longer_than_the_experiments_length() {
     assert_eq!(summary(out.path())["ticks"], 1210);
 }
 
+#[test]
+fn a_run_without_records_leaves_its_summary_and_snapshots_only() {
+    let out = temp_dir();
+    run_ok(
+        OBSTACLE_AVOIDANCE,
+        out.path(),
+        &["--ticks", "40", "--records", "off"],
+    );
+    let summary = summary(out.path());
+    assert_eq!(summary["ticks"], 40);
+    assert!(summary["metrics"].is_object(), "{summary}");
+    let mut names: Vec<String> = std::fs::read_dir(out.path())
+        .expect("the run folder")
+        .map(|e| {
+            e.expect("an entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .filter(|name| !name.starts_with('.'))
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "config.argos",
+            "event_tables.json",
+            "logs",
+            "scene.json",
+            "snapshot_000000.png",
+            "snapshot_000040.png",
+            "summary.json",
+            "supervisors"
+        ]
+    );
+}
+
 /// A launcher killed with SIGKILL takes its world and its agents with it, and the next run removes the shared
 /// memory it could not remove itself.
 #[test]

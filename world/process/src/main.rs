@@ -142,7 +142,7 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         &limits,
     )?
     .with_arrivals(faults::Arrivals::new(&experiment));
-    let mut recorder = Recorder::create(&args.out, &world, &[0], !args.records_csv)?;
+    let mut recorder = Recorder::create(&args.out, &world, &[0], args.records)?;
     let mut post = PostOffice::new(&world, link.robots());
     recorder.record(&mut world)?;
     report(WorldReport::Ready {

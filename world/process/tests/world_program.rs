@@ -23,7 +23,7 @@ fn world_args(dir: &Path, config: &Path) -> WorldArgs {
         limits: vec!["join_timeout_ms=1000".into()],
         real_time: false,
         faults: Vec::new(),
-        records_csv: false,
+        records: Default::default(),
     }
 }
 

@@ -30,6 +30,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use swarm_contract::messages::ActuatorCommand;
+pub use swarm_contract::protocol::launcher_to_world::Records;
 
 use crate::arena::GripperEvent;
 use crate::error::WorldError;
@@ -39,7 +40,8 @@ use crate::world::World;
 /// Records one run into a directory.
 pub struct Recorder {
     dir: PathBuf,
-    files: Background<RecordFiles>,
+    /// The record tables' writing thread; `None` with [`Records::Off`].
+    files: Option<Background<RecordFiles>>,
     snapshot_ticks: BTreeSet<u64>,
     loop_output: Option<LoopOutput>,
     object_moves: Option<objects_file::ObjectMoves>,
@@ -73,32 +75,39 @@ impl Recorder {
     /// Creates `dir` (if needed) and its `trajectory.csv` and `events.csv` for `world`'s robots (event names
     /// from the launcher's event tables in `dir`, if any); snapshots are drawn after each tick in
     /// `snapshot_ticks` (tick 0 is the initial placement: record it before the first tick), and of the final
-    /// state by [`Recorder::finish`]. With `parquet`, the record tables are also written as Parquet files, which
-    /// [`Recorder::finish`] completes.
+    /// state by [`Recorder::finish`]. With [`Records::Parquet`] the record tables are also written as Parquet
+    /// files, which [`Recorder::finish`] completes; with [`Records::Off`] there are no record tables (nor
+    /// `objects.csv`), only the scene, the pheromone field, the snapshots and the summary.
     pub fn create(
         dir: &Path,
         world: &World,
         snapshot_ticks: &[u64],
-        parquet: bool,
+        records: Records,
     ) -> Result<Self, WorldError> {
         std::fs::create_dir_all(dir).map_err(|source| WorldError::Io {
             path: dir.to_path_buf(),
             source,
         })?;
-        let (object_moves, objects) =
-            objects_file::ObjectsWriter::create(dir, &world.arena)?.unzip();
-        let files = RecordFiles {
-            events: EventsWriter::create(dir, &world.arena, world.coordinators(), parquet)?,
-            trajectory: TrajectoryWriter::create(
-                &dir.join(TRAJECTORY_FILE),
-                &world.arena,
-                parquet,
-            )?,
-            messages: world
-                .has_mail()
-                .then(|| messages::MessagesWriter::create(dir, parquet))
-                .transpose()?,
-            objects,
+        let parquet = records == Records::Parquet;
+        let (object_moves, files) = if records == Records::Off {
+            (None, None)
+        } else {
+            let (object_moves, objects) =
+                objects_file::ObjectsWriter::create(dir, &world.arena)?.unzip();
+            let files = RecordFiles {
+                events: EventsWriter::create(dir, &world.arena, world.coordinators(), parquet)?,
+                trajectory: TrajectoryWriter::create(
+                    &dir.join(TRAJECTORY_FILE),
+                    &world.arena,
+                    parquet,
+                )?,
+                messages: world
+                    .has_mail()
+                    .then(|| messages::MessagesWriter::create(dir, parquet))
+                    .transpose()?,
+                objects,
+            };
+            (object_moves, Some(Background::spawn(dir, files)?))
         };
         let pheromone = pheromone_file::PheromoneFile::create(dir, &world.arena)?;
         let pheromone_entry = pheromone
@@ -122,7 +131,7 @@ impl Recorder {
         };
         Ok(Self {
             dir: dir.to_path_buf(),
-            files: Background::spawn(dir, files)?,
+            files,
             snapshot_ticks: snapshot_ticks.iter().copied().collect(),
             loop_output,
             object_moves,
@@ -131,10 +140,17 @@ impl Recorder {
         })
     }
 
+    /// Hands `row` to the writing thread (nothing with [`Records::Off`]).
+    fn push(&mut self, row: RecordRow) {
+        if let Some(files) = &mut self.files {
+            files.push(row);
+        }
+    }
+
     /// Records the events `robot`'s command reports as fired.
     pub fn record_command(&mut self, robot: usize, command: &ActuatorCommand) {
         for &event in command.fired_events() {
-            self.files.push(RecordRow::Event(EventRow::Fired {
+            self.push(RecordRow::Event(EventRow::Fired {
                 tick: command.tick,
                 robot: robot as u32,
                 event,
@@ -145,13 +161,13 @@ impl Recorder {
     /// Records the messages medium's decisions of a tick (`messages.csv`).
     pub fn record_messages(&mut self, records: &[MessageRecord]) {
         for &record in records {
-            self.files.push(RecordRow::Message(record));
+            self.push(RecordRow::Message(record));
         }
     }
 
     /// Records a fault row: `name` (e.g. `fault:kill`) in the event column, taking effect at `tick`.
     pub fn record_fault(&mut self, tick: u64, robot: usize, name: &'static str) {
-        self.files.push(RecordRow::Event(EventRow::Fault {
+        self.push(RecordRow::Event(EventRow::Fault {
             tick,
             robot: robot as u32,
             name,
@@ -170,8 +186,8 @@ impl Recorder {
         if let Some(pheromone) = &mut self.pheromone {
             pheromone.record(&world.arena)?;
         }
-        if let Some(moves) = &mut self.object_moves {
-            moves.changes(&world.arena, |row| self.files.push(RecordRow::Object(row)));
+        if let (Some(moves), Some(files)) = (&mut self.object_moves, &mut self.files) {
+            moves.changes(&world.arena, |row| files.push(RecordRow::Object(row)));
         }
         let tick = world.tick();
         for event in &world.arena.gripper_events {
@@ -185,14 +201,16 @@ impl Recorder {
             };
             self.record_fault(tick, robot.index(), name);
         }
-        PoseRow::capture(&world.arena, |row| self.files.push(RecordRow::Pose(row)));
+        if let Some(files) = &mut self.files {
+            PoseRow::capture(&world.arena, |row| files.push(RecordRow::Pose(row)));
+            files.end_batch()?;
+        }
         let positions = world
             .arena
             .robots
             .iter()
             .map(|r| (r.present && r.alive && !r.removed).then_some(r.position));
         self.trails.sample(tick, positions);
-        self.files.end_batch()?;
         if self.snapshot_ticks.contains(&world.tick()) {
             self.snapshot(world)?;
         }
@@ -209,7 +227,7 @@ impl Recorder {
     /// world kill (the launcher kills it on that report) and before the launcher applies any other fault, so a
     /// world killed by its schedule leaves every earlier tick recorded.
     pub fn sync(&mut self) -> Result<(), WorldError> {
-        self.files.sync()
+        self.files.as_mut().map_or(Ok(()), Background::sync)
     }
 
     /// Writes the rest of `trajectory.csv` and `events.csv`, a snapshot of the final state (unless that tick
@@ -225,7 +243,9 @@ impl Recorder {
             self.snapshot(world)?;
         }
         let drawn = started.elapsed();
-        self.files.finish()?;
+        if let Some(files) = self.files {
+            files.finish()?;
+        }
         tracing::debug!(snapshot = ?drawn, files = ?(started.elapsed() - drawn), "records finished");
         let movable: Vec<serde_json::Value> = world
             .arena

@@ -8,6 +8,7 @@ use swarm_world::geometry::Vec2;
 use swarm_world::in_process::avoid_obstacles;
 use swarm_world::loop_functions::LoopFunctionsParams;
 use swarm_world::loop_functions::obstacle_avoidance::ObstacleAvoidance;
+use swarm_world::recorder::Records;
 use swarm_world::{Recorder, World};
 
 /// Runs the thesis example, with proximity noise 0.02 and wheel noise 0.05 so that every random stream is used,
@@ -17,7 +18,7 @@ fn recorded_run(seed: u64, ticks: u64, dir: &std::path::Path) -> Vec<u8> {
     exp.controllers[0].sensors[0].noise_level = 0.02;
     exp.controllers[0].actuators[0].noise_std_dev = 0.05;
     let mut world = World::new(&exp, seed).expect("builds");
-    let mut recorder = Recorder::create(dir, &world, &[], false).expect("recorder");
+    let mut recorder = Recorder::create(dir, &world, &[], Records::Csv).expect("recorder");
     recorder.record(&mut world).expect("record");
     for _ in 0..ticks {
         world.run_in_process(1, avoid_obstacles);
@@ -64,7 +65,7 @@ fn recorder_writes_summary_metrics_and_png_snapshots_of_the_start_and_the_final_
         location: crate::common::config::at(20),
     });
     let mut world = World::new(&exp, 7).expect("builds");
-    let mut recorder = Recorder::create(dir.path(), &world, &[0], false).expect("recorder");
+    let mut recorder = Recorder::create(dir.path(), &world, &[0], Records::Csv).expect("recorder");
     recorder.record(&mut world).expect("record");
     for _ in 0..20 {
         world.run_in_process(1, avoid_obstacles);
@@ -95,7 +96,8 @@ fn a_finished_recorder_completes_the_parquet_tables_and_an_unfinished_one_leaves
     for finished in [true, false] {
         let dir = tempfile::tempdir().expect("tempdir");
         let mut world = World::new(&exp, 3).expect("builds");
-        let mut recorder = Recorder::create(dir.path(), &world, &[], true).expect("recorder");
+        let mut recorder =
+            Recorder::create(dir.path(), &world, &[], Records::Parquet).expect("recorder");
         recorder.record(&mut world).expect("record");
         for _ in 0..30 {
             world.run_in_process(1, avoid_obstacles);

@@ -29,6 +29,7 @@ use swarm_cli::launcher::control::{self, CtlCommand};
 use swarm_cli::launcher::{self, RunOptions};
 use swarm_contract::config::hosts::TlsFiles;
 use swarm_contract::process::binaries::Binaries;
+use swarm_contract::protocol::launcher_to_world::Records;
 use swarm_contract::protocol::launcher_to_world::SpawnPose;
 use swarm_remote::auth::{HostKey, Seal, create_missing_keys, default_key_dir, key_path};
 use swarm_remote::codec::DEFAULT_MAX_PAYLOAD;
@@ -117,10 +118,10 @@ enum Commands {
             default_value = "127.0.0.1"
         )]
         view_bind: IpAddr,
-        /// The format the run's records (trajectory, events, messages) are left in: Parquet, converted from the
-        /// CSV the world appends while the run goes, or that CSV as it is (docs/records.md).
-        #[arg(long, value_enum, value_name = "FORMAT", default_value_t = swarm_records::Format::Parquet)]
-        records: swarm_records::Format,
+        /// What the run leaves of its record tables (trajectory, events, messages): Parquet files, the CSV files
+        /// the world appends while the run goes, or none at all (docs/records.md).
+        #[arg(long, value_enum, value_name = "RECORDS", default_value_t = Records::Parquet)]
+        records: Records,
     },
     /// Convert a run's record files (trajectory, events, messages) to CSV beside the Parquet files a run leaves,
     /// or to Apache Parquet beside the CSV files of a `--records csv` run (docs/records.md).

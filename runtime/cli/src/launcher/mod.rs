@@ -51,8 +51,8 @@ use swarm_contract::limits::LimitError;
 use swarm_contract::process::binaries::{Binaries, BinariesError};
 use swarm_contract::process::children::{self, Children};
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs};
-use swarm_contract::protocol::launcher_to_world::WorldArgs;
 use swarm_contract::protocol::launcher_to_world::WorldCommand;
+use swarm_contract::protocol::launcher_to_world::{Records, WorldArgs};
 use swarm_contract::protocol::world_to_launcher::WorldReport;
 use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE, RunDirError};
 use swarm_contract::transport::{self, RunSpec};
@@ -95,9 +95,9 @@ pub struct RunOptions {
     /// Serve the live viewer of the run at this address (`swarm run --view`); its URL is printed as soon as
     /// the run directory exists.
     pub view: Option<SocketAddr>,
-    /// The format the run's records are left in (`swarm run --records`): the world appends CSV as the run goes;
-    /// with Parquet (the default) they are converted when it ends.
-    pub records: swarm_records::Format,
+    /// What the run leaves of its record tables (`swarm run --records`): Parquet files (the default), the CSV
+    /// files the world appends to, or nothing.
+    pub records: Records,
 }
 
 /// What a finished run reports.
@@ -373,7 +373,7 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         limits: options.limits.clone(),
         real_time: options.real_time,
         faults: options.faults.clone(),
-        records_csv: options.records == swarm_records::Format::Csv,
+        records: options.records,
     };
     let mut world = children::spawn(
         Command::new(&binaries.world)

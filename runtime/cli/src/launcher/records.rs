@@ -12,6 +12,7 @@
 
 use std::path::Path;
 
+use swarm_contract::protocol::launcher_to_world::Records;
 use swarm_contract::run_dir::{self, EVENTS_FILE, MESSAGES_FILE, TRAJECTORY_FILE};
 
 /// Cuts the records in `run_dir` back to the last complete tick of `robots` robots; returns that tick (`None`
@@ -54,10 +55,10 @@ pub fn trim_to_complete_ticks(run_dir: &Path, robots: u32) -> std::io::Result<Op
     Ok(Some(last))
 }
 
-/// Leaves the records of the ended run in `run_dir` in `format`. A conversion that fails leaves the CSV files
+/// Leaves the records of the ended run in `run_dir` as `records` asks. A conversion that fails leaves the CSV files
 /// whole and is reported as a warning: the run's records are complete either way.
-pub fn finish(run_dir: &Path, format: swarm_records::Format) {
-    if format == swarm_records::Format::Csv {
+pub fn finish(run_dir: &Path, records: Records) {
+    if records != Records::Parquet {
         return;
     }
     match swarm_records::finish_run_records(run_dir) {

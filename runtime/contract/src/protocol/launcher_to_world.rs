@@ -48,10 +48,33 @@ pub struct WorldArgs {
     /// Faults given on the command line (`swarm run --fault`), added to the configuration's `<faults>`.
     #[arg(long = "fault")]
     pub faults: Vec<String>,
-    /// Write the record tables as CSV only (`swarm run --records csv`); by default each is also written as
-    /// Parquet, completed when the run ends normally.
-    #[arg(long = "records-csv")]
-    pub records_csv: bool,
+    /// What becomes of the record tables (`swarm run --records`).
+    #[arg(long, value_enum, default_value_t = Records::Parquet)]
+    pub records: Records,
+}
+
+/// What a run leaves of its record tables (trajectory, events, messages; docs/records.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Records {
+    /// Parquet files: the world writes them beside the CSV files as the run goes, and the launcher removes the
+    /// CSV files when it ends.
+    #[default]
+    Parquet,
+    /// The CSV files the world appends to, only.
+    Csv,
+    /// None: no trajectory, events, messages or objects file (summary, snapshots and scene are still written),
+    /// for runs whose records nobody reads and for measuring what recording costs.
+    Off,
+}
+
+impl fmt::Display for Records {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Records::Parquet => "parquet",
+            Records::Csv => "csv",
+            Records::Off => "off",
+        })
+    }
 }
 
 impl WorldArgs {
@@ -80,9 +103,7 @@ impl WorldArgs {
         for fault in &self.faults {
             args.extend(["--fault".into(), fault.clone()]);
         }
-        if self.records_csv {
-            args.push("--records-csv".into());
-        }
+        args.extend(["--records".into(), self.records.to_string()]);
         args
     }
 }
@@ -231,7 +252,7 @@ mod tests {
             limits: vec!["tick_deadline_ms=250".into(), "join_timeout_ms=5000".into()],
             real_time: true,
             faults: vec!["kill robots=3 tick=50".into()],
-            records_csv: true,
+            records: Records::Csv,
         };
         let line = std::iter::once("swarm-world".to_string()).chain(args.to_args());
         assert_eq!(World::parse_from(line).args, args);
