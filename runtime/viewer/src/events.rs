@@ -16,6 +16,10 @@ pub const HEADER: &str = "tick,robot,robot_id,event";
 pub const MAX_MARKERS: usize = 5000;
 /// Participant indices accepted at most when the scene does not say how many there are.
 const MAX_PARTICIPANTS: usize = 1 << 20;
+/// Rows of `events.parquet` held at most (12 bytes each: 1.6 GB). Parquet's run-length encoding lets a small
+/// file claim billions of rows, so a file claiming more is refused rather than loaded; a 1,000-robot,
+/// 10,000-tick run has 6.5 million.
+const MAX_PARQUET_ROWS: u64 = 1 << 27;
 /// Distinct event names at most (they are interned as `u16`).
 const MAX_NAMES: usize = u16::MAX as usize;
 
@@ -113,16 +117,13 @@ impl EventsIndex {
         }
         if self.parquet.exists() {
             self.parquet_read = true;
-            let mut table = Table::new(self.table.participants_limit);
-            table.header_seen = true;
-            let read = ParquetTable::open(RecordTable::Events, &self.parquet).and_then(|file| {
-                (0..file.row_groups()).try_for_each(|group| {
-                    file.read_row_group(group, |_, values| table.add_row(values))
-                        .map(drop)
-                })
-            });
+            let (table, problem) = load_parquet(
+                &self.parquet,
+                self.table.participants_limit,
+                MAX_PARQUET_ROWS,
+            );
             self.table = table;
-            self.problem = read.err().map(|e| e.to_string());
+            self.problem = problem;
             return true;
         }
         let table = &mut self.table;
@@ -276,6 +277,29 @@ impl Table {
     }
 }
 
+/// The events of the Parquet file at `path`, and why not all of them when some are missing.
+fn load_parquet(path: &Path, participants_limit: usize, max_rows: u64) -> (Table, Option<String>) {
+    let mut table = Table::new(participants_limit);
+    table.header_seen = true;
+    let file = match ParquetTable::open(RecordTable::Events, path) {
+        Ok(file) => file,
+        Err(e) => return (table, Some(e.to_string())),
+    };
+    let rows: u64 = (0..file.row_groups()).map(|group| file.rows(group)).sum();
+    if rows > max_rows {
+        let problem = format!(
+            "{}: {rows} rows, more than the viewer holds ({max_rows}): the events are not shown",
+            path.display()
+        );
+        return (table, Some(problem));
+    }
+    let read = (0..file.row_groups()).try_for_each(|group| {
+        file.read_row_group(group, |_, values| table.add_row(values))
+            .map(drop)
+    });
+    (table, read.err().map(|e| e.to_string()))
+}
+
 fn utf8(value: &[u8]) -> Result<&str, String> {
     std::str::from_utf8(value).map_err(|_| "a text column is not UTF-8".to_owned())
 }
@@ -342,5 +366,31 @@ mod tests {
             ),
             "{problem}"
         );
+    }
+
+    #[test]
+    fn parquet_events_are_read_whole_unless_they_claim_too_many_rows() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::write(
+            dir.path().join("events.csv"),
+            format!("{HEADER}\n1,0,ep0,go\n3,1,ep1,fault:freeze\n7,1,ep1,fault:thaw\n"),
+        )
+        .expect("written");
+        swarm_records::export(dir.path(), swarm_records::Format::Parquet).expect("exported");
+        std::fs::remove_file(dir.path().join("events.csv")).expect("removed");
+        let mut index = EventsIndex::new(dir.path(), Some(2));
+        assert!(index.update());
+        assert_eq!(index.problem(), None);
+        assert_eq!(index.flags_at(1, 4), (true, false));
+        assert_eq!(
+            index.events_until(0, 9).collect::<Vec<_>>(),
+            vec![(1, "go")]
+        );
+        let path = dir.path().join("events.parquet");
+        let (table, problem) = load_parquet(&path, 2, 2);
+        assert!(table.participants.is_empty());
+        assert!(problem.is_some_and(|p| {
+            p.ends_with("3 rows, more than the viewer holds (2): the events are not shown")
+        }));
     }
 }

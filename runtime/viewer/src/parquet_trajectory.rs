@@ -10,6 +10,10 @@ use swarm_records::{ParquetTable, Table, Value};
 
 use crate::trajectory::Pose;
 
+/// Rows of one row group decoded at most (20 bytes a pose: 80 MB). The runs' own files hold about 65,536 rows
+/// a group (or one tick of a larger swarm); a file claiming more is refused rather than allowed to claim memory.
+pub const MAX_GROUP_ROWS: u64 = 1 << 22;
+
 /// A finished run's trajectory in Parquet.
 pub struct ParquetTrajectory {
     table: ParquetTable,
@@ -24,6 +28,15 @@ impl ParquetTrajectory {
     /// Opens the file at `path` of a run of `robots` robots (`None`: learn it from the first row group), or says
     /// why it cannot be shown.
     pub fn open(path: &Path, robots: Option<usize>) -> Result<ParquetTrajectory, String> {
+        Self::open_with_limit(path, robots, MAX_GROUP_ROWS)
+    }
+
+    /// [`ParquetTrajectory::open`], refusing row groups of more than `max_group_rows` rows.
+    fn open_with_limit(
+        path: &Path,
+        robots: Option<usize>,
+        max_group_rows: u64,
+    ) -> Result<ParquetTrajectory, String> {
         let table = ParquetTable::open(Table::Trajectory, path).map_err(|e| e.to_string())?;
         let name = path.display();
         let mut groups: Vec<(u64, u64)> = Vec::with_capacity(table.row_groups());
@@ -46,6 +59,12 @@ impl ParquetTrajectory {
                 .and_then(|span| span.checked_add(1))
                 .ok_or_else(|| format!("{name}: row group {index} ends before it starts"))?;
             let rows = table.rows(index);
+            if rows > max_group_rows {
+                return Err(format!(
+                    "{name}: row group {index} holds {rows} rows, more than the viewer reads at once \
+                     ({max_group_rows}): it was not written by a run"
+                ));
+            }
             let per_tick = *robots.get_or_insert((rows / ticks) as usize);
             if per_tick == 0 || rows != ticks.saturating_mul(per_tick as u64) {
                 return Err(format!(
@@ -142,5 +161,50 @@ fn pose_of(values: &[Value<'_>]) -> Result<(u64, usize, Pose), String> {
             },
         )),
         _ => Err("the row is not a trajectory row".to_owned()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run folder whose `trajectory.parquet` holds `ticks` ticks of `robots` robots, in one row group.
+    fn run(ticks: u64, robots: usize) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut csv = String::from(crate::trajectory::HEADER);
+        csv.push('\n');
+        for tick in 0..ticks {
+            for robot in 0..robots {
+                csv += &format!("{tick},{robot},r{robot},{robot}.5,{tick}.25,0.5,255,0,0,1\n");
+            }
+        }
+        std::fs::write(dir.path().join("trajectory.csv"), csv).expect("written");
+        swarm_records::export(dir.path(), swarm_records::Format::Parquet).expect("exported");
+        dir
+    }
+
+    #[test]
+    fn reads_any_tick_of_a_run() {
+        let dir = run(5, 3);
+        let trajectory =
+            ParquetTrajectory::open(&dir.path().join("trajectory.parquet"), None).expect("opened");
+        assert_eq!((trajectory.robots(), trajectory.ticks()), (3, Some((0, 4))));
+        let poses = trajectory.read_tick(3).expect("tick 3");
+        assert_eq!(
+            (poses[2].x, poses[2].y, poses[2].led),
+            (2.5, 3.25, [255, 0, 0])
+        );
+        assert!(trajectory.read_tick(5).is_err());
+    }
+
+    #[test]
+    fn a_row_group_larger_than_the_limit_is_refused_before_it_is_read() {
+        let dir = run(4, 2);
+        let path = dir.path().join("trajectory.parquet");
+        let problem = ParquetTrajectory::open_with_limit(&path, Some(2), 7)
+            .err()
+            .expect("refused");
+        assert!(problem.contains("row group 0 holds 8 rows"), "{problem}");
+        assert!(ParquetTrajectory::open_with_limit(&path, Some(2), 8).is_ok());
     }
 }
