@@ -64,16 +64,6 @@ impl ParquetTable {
         })
     }
 
-    /// The table the file holds.
-    pub fn table(&self) -> Table {
-        self.table
-    }
-
-    /// The file.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
     /// Row groups in the file.
     pub fn row_groups(&self) -> usize {
         self.reader.num_row_groups()
