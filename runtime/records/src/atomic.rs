@@ -20,7 +20,7 @@ impl AtomicFile {
         let name = path
             .file_name()
             .map_or_else(|| "file".into(), |n| n.to_string_lossy().into_owned());
-        let temporary = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+        let temporary = path.with_file_name(temporary_name(&name, std::process::id()));
         let file = File::create(&temporary).map_err(|source| ExportError::Io {
             path: temporary.clone(),
             source,
@@ -50,6 +50,22 @@ impl AtomicFile {
         self.committed = true;
         Ok(())
     }
+}
+
+/// The temporary name process `pid` writes the file `name` under.
+fn temporary_name(name: &str, pid: u32) -> String {
+    format!(".{name}.{pid}.tmp")
+}
+
+/// Whether `file_name` is a temporary file some process wrote `name` under and left (it was killed before it
+/// renamed it).
+pub(super) fn is_temporary_of(file_name: &str, name: &str) -> bool {
+    file_name
+        .strip_prefix('.')
+        .and_then(|rest| rest.strip_prefix(name))
+        .and_then(|rest| rest.strip_prefix('.'))
+        .and_then(|rest| rest.strip_suffix(".tmp"))
+        .is_some_and(|pid| pid.parse::<u32>().is_ok())
 }
 
 impl Drop for AtomicFile {

@@ -182,20 +182,6 @@ impl Values {
         }
     }
 
-    /// Appends `value`; a null has no value here (its definition level says it is missing).
-    pub fn push(&mut self, value: Value<'_>) -> Result<(), String> {
-        match (self, value) {
-            (_, Value::Null) => {}
-            (Values::Int64(v), Value::Int64(x)) => v.push(x),
-            (Values::Int32(v), Value::Int32(x)) => v.push(x),
-            (Values::Float(v), Value::Float(x)) => v.push(x),
-            (Values::Boolean(v), Value::Boolean(x)) => v.push(x),
-            (Values::Text(v), Value::Text(x)) => v.push(ByteArray::from(x.to_vec())),
-            (_, other) => return Err(format!("{other:?} is not a value of this column")),
-        }
-        Ok(())
-    }
-
     /// Empties the buffer, keeping its memory.
     pub fn clear(&mut self) {
         match self {

@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use crate::atomic::is_temporary_of;
 use crate::{ExportError, ExportReport, Format, Table, convert};
 
 /// Leaves every record table of the ended run in `run_dir` as a Parquet file: a table whose Parquet file the
@@ -77,11 +78,9 @@ fn remove_unfinished(run_dir: &Path) {
     for entry in entries.flatten() {
         let name = entry.file_name();
         let name = name.to_string_lossy();
-        let unfinished = Table::ALL.iter().any(|table| {
-            name.strip_prefix('.')
-                .and_then(|rest| rest.strip_prefix(table.parquet_name()))
-                .is_some_and(|rest| rest.starts_with('.') && rest.ends_with(".tmp"))
-        });
+        let unfinished = Table::ALL
+            .iter()
+            .any(|table| is_temporary_of(&name, table.parquet_name()));
         if unfinished {
             let _ = std::fs::remove_file(entry.path());
         }

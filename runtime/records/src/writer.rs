@@ -282,17 +282,21 @@ impl RowGroup {
 }
 
 impl ColumnValues {
+    /// Appends `value`; a null has no value among the values (its definition level says it is missing).
     fn push(&mut self, value: Value<'_>) -> Result<(), String> {
         if let Some(levels) = &mut self.levels {
             levels.push(i16::from(value != Value::Null));
         }
         match (&mut self.values, value) {
-            (Values::Text(values), Value::Text(text)) => {
-                values.push(self.interned.get(text));
-                Ok(())
-            }
-            (values, value) => values.push(value),
+            (_, Value::Null) => {}
+            (Values::Int64(v), Value::Int64(x)) => v.push(x),
+            (Values::Int32(v), Value::Int32(x)) => v.push(x),
+            (Values::Float(v), Value::Float(x)) => v.push(x),
+            (Values::Boolean(v), Value::Boolean(x)) => v.push(x),
+            (Values::Text(v), Value::Text(x)) => v.push(self.interned.get(x)),
+            (_, other) => return Err(format!("{other:?} is not a value of this column")),
         }
+        Ok(())
     }
 
     fn write(&self, writer: &mut ColumnWriter<'_>) -> Result<(), ParquetError> {
