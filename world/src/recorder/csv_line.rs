@@ -11,6 +11,8 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use swarm_records::Table;
+
 use super::parquet_twin::ParquetTwin;
 use crate::error::WorldError;
 
@@ -22,27 +24,33 @@ pub struct CsvFile {
 }
 
 impl CsvFile {
-    /// Creates (truncates) `path` with a buffer of `capacity` bytes and writes `header` as its first line. With
-    /// `twin`, every line also goes into that table's Parquet file.
-    pub fn create(
-        path: &Path,
-        header: &str,
-        capacity: usize,
-        twin: Option<swarm_records::Table>,
-    ) -> Result<CsvFile, WorldError> {
+    /// Creates (truncates) `path` with a buffer of `capacity` bytes and writes `header` as its first line.
+    pub fn create(path: &Path, header: &str, capacity: usize) -> Result<CsvFile, WorldError> {
         let file = File::create(path).map_err(|source| WorldError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let dir = path.parent().unwrap_or(Path::new("."));
         let mut csv = CsvFile {
             path: path.to_path_buf(),
             out: BufWriter::with_capacity(capacity, file),
-            twin: twin
-                .map(|table| ParquetTwin::create(table, dir))
-                .transpose()?,
+            twin: None,
         };
         writeln!(csv.out, "{header}").map_err(|source| csv.error(source))?;
+        Ok(csv)
+    }
+
+    /// Creates the run folder `dir`'s CSV file of `table`, with the table's header; with `parquet`, every line
+    /// also goes into the table's Parquet file.
+    pub fn for_table(
+        dir: &Path,
+        table: Table,
+        capacity: usize,
+        parquet: bool,
+    ) -> Result<CsvFile, WorldError> {
+        let mut csv = CsvFile::create(&dir.join(table.csv_name()), &table.header(), capacity)?;
+        csv.twin = parquet
+            .then(|| ParquetTwin::create(table, dir))
+            .transpose()?;
         Ok(csv)
     }
 
@@ -60,7 +68,7 @@ impl CsvFile {
     pub fn close(&mut self) -> Result<(), WorldError> {
         self.flush()?;
         match self.twin.take() {
-            Some(twin) => twin.finish(self.path.parent().unwrap_or(Path::new("."))),
+            Some(twin) => twin.finish(),
             None => Ok(()),
         }
     }

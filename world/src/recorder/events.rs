@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use swarm_contract::run_dir::{EVENT_TABLES_FILE, EVENTS_FILE};
+use swarm_contract::run_dir::EVENT_TABLES_FILE;
 
 use super::csv_line::CsvFile;
 use crate::arena::Arena;
@@ -62,12 +62,7 @@ impl EventsWriter {
             })?,
             Err(_) => BTreeMap::new(),
         };
-        let file = CsvFile::create(
-            &dir.join(EVENTS_FILE),
-            "tick,robot,robot_id,event",
-            1 << 13,
-            parquet.then_some(swarm_records::Table::Events),
-        )?;
+        let file = CsvFile::for_table(dir, swarm_records::Table::Events, 1 << 13, parquet)?;
         let named = |id: &str, controller: &str| {
             (
                 id.to_owned(),

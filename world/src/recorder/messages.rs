@@ -4,7 +4,6 @@
 use std::path::Path;
 
 use swarm_contract::mail::{Address, FROM_WORLD, TO_WORLD};
-use swarm_contract::run_dir::MESSAGES_FILE;
 
 use super::csv_line::CsvFile;
 use crate::error::WorldError;
@@ -18,12 +17,7 @@ pub struct MessagesWriter {
 impl MessagesWriter {
     /// Creates `messages.csv` in `dir` with its header line; with `parquet`, also the table's Parquet file.
     pub fn create(dir: &Path, parquet: bool) -> Result<MessagesWriter, WorldError> {
-        let file = CsvFile::create(
-            &dir.join(MESSAGES_FILE),
-            "tick,from,to,address,bytes,outcome,reason",
-            1 << 13,
-            parquet.then_some(swarm_records::Table::Messages),
-        )?;
+        let file = CsvFile::for_table(dir, swarm_records::Table::Messages, 1 << 13, parquet)?;
         Ok(MessagesWriter { file })
     }
 

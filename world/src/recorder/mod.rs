@@ -19,7 +19,7 @@ mod snapshot_labels;
 pub mod trails;
 pub mod trajectory;
 
-use swarm_contract::run_dir::{SUMMARY_FILE, TRAJECTORY_FILE};
+use swarm_contract::run_dir::SUMMARY_FILE;
 
 pub use background::{Background, RowWriter};
 pub use events::{EventRow, EventsWriter};
@@ -96,11 +96,7 @@ impl Recorder {
                 objects_file::ObjectsWriter::create(dir, &world.arena)?.unzip();
             let files = RecordFiles {
                 events: EventsWriter::create(dir, &world.arena, world.coordinators(), parquet)?,
-                trajectory: TrajectoryWriter::create(
-                    &dir.join(TRAJECTORY_FILE),
-                    &world.arena,
-                    parquet,
-                )?,
+                trajectory: TrajectoryWriter::create(dir, &world.arena, parquet)?,
                 messages: world
                     .has_mail()
                     .then(|| messages::MessagesWriter::create(dir, parquet))

@@ -144,7 +144,7 @@ impl ObjectsWriter {
             obstacles: vec![None; arena.obstacles.len()],
         };
         let writer = Self {
-            file: CsvFile::create(&dir.join(OBJECTS_FILE), OBJECTS_HEADER, 1 << 12, None)?,
+            file: CsvFile::create(&dir.join(OBJECTS_FILE), OBJECTS_HEADER, 1 << 12)?,
             target_ids: arena.targets.iter().map(|t| t.name.clone()).collect(),
             obstacle_ids: arena.obstacles.iter().map(|o| o.name.clone()).collect(),
         };

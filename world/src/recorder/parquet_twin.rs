@@ -4,7 +4,7 @@
 //! unfinished (a temporary file) and the launcher converts the CSV file cut back to whole ticks instead.
 
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use swarm_records::{Field, MAX_COLUMNS, Table, TableWriter, Value};
 
@@ -22,6 +22,7 @@ enum Slot {
 /// The Parquet file of one table, fed line by line.
 pub struct ParquetTwin {
     table: Table,
+    path: PathBuf,
     writer: TableWriter,
     line: Vec<Slot>,
     text: String,
@@ -30,10 +31,11 @@ pub struct ParquetTwin {
 impl ParquetTwin {
     /// Starts `table`'s Parquet file in the run folder `dir`.
     pub fn create(table: Table, dir: &Path) -> Result<ParquetTwin, WorldError> {
-        let writer = TableWriter::create(table, &dir.join(table.parquet_name()))
-            .map_err(|e| error(table, dir, e))?;
+        let path = dir.join(table.parquet_name());
+        let writer = TableWriter::create(table, &path).map_err(|e| error(&path, e))?;
         Ok(ParquetTwin {
             table,
+            path,
             writer,
             line: Vec::with_capacity(table.columns().len()),
             text: String::new(),
@@ -97,18 +99,15 @@ impl ParquetTwin {
     }
 
     /// Writes the last row group and the footer, and renames the file into place.
-    pub fn finish(self, dir: &Path) -> Result<(), WorldError> {
-        let table = self.table;
-        self.writer
-            .finish()
-            .map(drop)
-            .map_err(|e| error(table, dir, e))
+    pub fn finish(self) -> Result<(), WorldError> {
+        let path = self.path;
+        self.writer.finish().map(drop).map_err(|e| error(&path, e))
     }
 }
 
-fn error(table: Table, dir: &Path, e: swarm_records::ExportError) -> WorldError {
+fn error(path: &Path, e: swarm_records::ExportError) -> WorldError {
     WorldError::Io {
-        path: dir.join(table.parquet_name()),
+        path: path.to_path_buf(),
         source: std::io::Error::other(e.to_string()),
     }
 }

@@ -11,9 +11,6 @@ use super::csv_line::CsvFile;
 use crate::arena::Arena;
 use crate::error::WorldError;
 
-/// The header line.
-pub const TRAJECTORY_HEADER: &str = "tick,robot,robot_id,x,y,heading,led_r,led_g,led_b,alive";
-
 /// One robot's row of one tick, before formatting.
 #[derive(Clone, Copy, Debug)]
 pub struct PoseRow {
@@ -62,12 +59,11 @@ pub struct TrajectoryWriter {
 }
 
 impl TrajectoryWriter {
-    /// Creates (truncates) the file for the arena's robots and writes the header; with `parquet`, also the
-    /// table's Parquet file.
-    pub fn create(path: &Path, arena: &Arena, parquet: bool) -> Result<Self, WorldError> {
-        let twin = parquet.then_some(swarm_records::Table::Trajectory);
+    /// Creates (truncates) the run folder `dir`'s file for the arena's robots and writes the header; with
+    /// `parquet`, also the table's Parquet file.
+    pub fn create(dir: &Path, arena: &Arena, parquet: bool) -> Result<Self, WorldError> {
         Ok(Self {
-            file: CsvFile::create(path, TRAJECTORY_HEADER, 1 << 16, twin)?,
+            file: CsvFile::for_table(dir, swarm_records::Table::Trajectory, 1 << 16, parquet)?,
             names: arena.robots.iter().map(|r| r.name.clone()).collect(),
         })
     }
