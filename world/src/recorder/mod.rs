@@ -16,6 +16,7 @@ pub mod pheromone_file;
 pub mod scene_file;
 pub mod snapshot;
 mod snapshot_labels;
+mod trail_lines;
 pub mod trails;
 pub mod trajectory;
 

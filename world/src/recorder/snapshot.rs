@@ -16,6 +16,7 @@ use crate::geometry::{Placed, Shape, Vec2, unit};
 use crate::world::World;
 
 use super::snapshot_labels;
+use super::trail_lines::TrailPen;
 use super::trails::Trails;
 
 /// Pixels per metre of a snapshot.
@@ -176,7 +177,8 @@ pub(super) fn draw_light(pixmap: &mut Pixmap, position: Vec2, tf: Transform) {
     }
 }
 
-/// Strokes `path` as a trail.
+/// Strokes `path` in the trails' colour (the legend's swatch; the trails themselves are drawn by
+/// [`TrailPen`]).
 pub(super) fn stroke_trail(pixmap: &mut Pixmap, path: &tiny_skia::Path, tf: Transform) {
     let stroke = Stroke {
         width: 0.01,
@@ -210,16 +212,10 @@ pub(super) fn fill_placed(pixmap: &mut Pixmap, placed: &Placed, paint: &Paint, t
 
 /// Each robot's trail as a thin translucent line, broken where the robot was out of the run.
 fn draw_trails(arena: &Arena, trails: &Trails, pixmap: &mut Pixmap, tf: Transform) {
+    let pen = TrailPen::new(TRAIL);
     for index in 0..arena.robots.len() {
-        let mut pb = PathBuilder::new();
         for piece in trails.pieces(index) {
-            pb.move_to(piece[0].x, piece[0].y);
-            for p in &piece[1..] {
-                pb.line_to(p.x, p.y);
-            }
-        }
-        if let Some(path) = pb.finish() {
-            stroke_trail(pixmap, &path, tf);
+            pen.polyline(pixmap, piece, tf);
         }
     }
 }
