@@ -242,7 +242,9 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             object.extend(cpu);
         }
     }
-    // The agents exit while the records are finished (the final snapshot alone takes 0.2 s at 1,000 robots).
+    // The record files first, while the agents still sleep (see `Recorder::complete_records`); then the agents
+    // exit while the final snapshot is drawn.
+    recorder.complete_records()?;
     link.end();
     recorder.finish(&world, extra)?;
     report(WorldReport::Finished { ticks });
