@@ -110,33 +110,36 @@ impl RunSpec {
     /// process of the run was killed, and when nothing is left. Returns the number of entries removed.
     pub fn cleanup(&self) -> Result<usize, TransportError> {
         let prefix = self.shm_prefix();
-        let mut removed = 0;
-        let entries = std::fs::read_dir(SHM_DIR).map_err(|source| TransportError::Cleanup {
+        let flat = std::fs::read_dir(SHM_DIR).map_err(|source| TransportError::Cleanup {
             path: PathBuf::from(SHM_DIR),
             source,
         })?;
-        for entry in entries.flatten() {
-            if entry.file_name().to_string_lossy().starts_with(&prefix) {
-                match std::fs::remove_file(entry.path()) {
-                    Ok(()) => removed += 1,
-                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                    Err(source) => {
-                        return Err(TransportError::Cleanup {
-                            path: entry.path(),
-                            source,
-                        });
-                    }
-                }
-            }
+        let mut doomed: Vec<Entry> = flat
+            .flatten()
+            .filter(|entry| entry.file_name().to_string_lossy().starts_with(&prefix))
+            .map(Entry::of)
+            .collect();
+        // The root's subfolders (nodes, services) hold most of the entries: they are shared out entry by entry,
+        // and removed themselves once empty.
+        let (folders, files): (Vec<Entry>, Vec<Entry>) = entries_of(&self.root_dir)?
+            .into_iter()
+            .partition(|e| e.is_dir);
+        for folder in &folders {
+            doomed.extend(entries_of(&folder.path)?);
         }
-        match std::fs::remove_dir_all(&self.root_dir) {
-            Ok(()) => removed += 1,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(source) => {
-                return Err(TransportError::Cleanup {
-                    path: self.root_dir.clone(),
-                    source,
-                });
+        doomed.extend(files);
+        let mut removed = remove_in_parallel(&doomed)?;
+        let emptied = folders.into_iter().map(|folder| folder.path);
+        for folder in emptied.chain([self.root_dir.clone()]) {
+            match std::fs::remove_dir_all(&folder) {
+                Ok(()) => removed += 1,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(source) => {
+                    return Err(TransportError::Cleanup {
+                        path: folder,
+                        source,
+                    });
+                }
             }
         }
         Ok(removed)
@@ -202,5 +205,70 @@ impl RunSpec {
             found.push(self.root_dir.clone());
         }
         found
+    }
+}
+
+/// A file or folder to remove; a symbolic link counts as a file (it is removed, not followed).
+struct Entry {
+    path: PathBuf,
+    is_dir: bool,
+}
+
+impl Entry {
+    fn of(entry: std::fs::DirEntry) -> Entry {
+        Entry {
+            is_dir: entry.file_type().is_ok_and(|kind| kind.is_dir()),
+            path: entry.path(),
+        }
+    }
+}
+
+/// The entries of folder `dir` (none if it does not exist).
+fn entries_of(dir: &Path) -> Result<Vec<Entry>, TransportError> {
+    match std::fs::read_dir(dir) {
+        Ok(entries) => Ok(entries.flatten().map(Entry::of).collect()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
+        Err(source) => Err(TransportError::Cleanup {
+            path: dir.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// Removes `paths` (files, or folders with everything in them) from one thread per CPU; returns how many were
+/// there. A run of 1,000 robots leaves about 15,000 entries, which one thread took 80 ms to remove, after the
+/// run, while the user waits.
+fn remove_in_parallel(entries: &[Entry]) -> Result<usize, TransportError> {
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let share = entries.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        let workers: Vec<_> = entries
+            .chunks(share)
+            .map(|chunk| {
+                scope.spawn(move || chunk.iter().map(remove_entry).sum::<Result<usize, _>>())
+            })
+            .collect();
+        workers
+            .into_iter()
+            .map(|worker| worker.join().unwrap_or(Ok(0)))
+            .sum()
+    })
+}
+
+/// Removes `entry`: 1 if it was there, 0 if it was gone already.
+fn remove_entry(entry: &Entry) -> Result<usize, TransportError> {
+    let path = &entry.path;
+    let removed = if entry.is_dir {
+        std::fs::remove_dir_all(path)
+    } else {
+        std::fs::remove_file(path)
+    };
+    match removed {
+        Ok(()) => Ok(1),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(0),
+        Err(source) => Err(TransportError::Cleanup {
+            path: path.clone(),
+            source,
+        }),
     }
 }
