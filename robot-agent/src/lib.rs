@@ -11,6 +11,7 @@ pub mod binding;
 pub mod control;
 pub mod controller;
 pub mod from_config;
+pub mod huge_text;
 pub mod native;
 pub mod params;
 pub mod profile;

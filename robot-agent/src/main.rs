@@ -342,6 +342,10 @@ fn run_zygote(args: &ZygoteArgs) -> Result<()> {
     };
     install_stop_handler()?;
     let zygote = Zygote::prepare().context("preparing to fork agents")?;
+    match robot_agent::huge_text::move_code_to_huge_pages() {
+        Ok(outcome) => tracing::debug!(?outcome, "the agents' code"),
+        Err(e) => tracing::warn!("the agents' code stays on small pages: {e}"),
+    }
     let mut out = std::io::stdout();
     for order in orders {
         let reply = match zygote.fork_agent() {
