@@ -32,8 +32,11 @@ pub enum Outcome {
     Kept,
 }
 
-/// Moves this process's code onto huge pages; see the module documentation. Call only with one thread.
-pub fn move_code_to_huge_pages() -> io::Result<Outcome> {
+/// Moves this process's code onto huge pages; see the module documentation.
+///
+/// # Safety
+/// The process must have one thread: the code is replaced under the running program.
+pub unsafe fn move_code_to_huge_pages() -> io::Result<Outcome> {
     if std::env::var_os("SWARM_AGENT_SMALL_PAGES").is_some_and(|v| v == "1") {
         return Ok(Outcome::Kept);
     }
@@ -43,8 +46,7 @@ pub fn move_code_to_huge_pages() -> io::Result<Outcome> {
         return Ok(Outcome::DoesNotFit);
     };
     // SAFETY: `region` is this program's code mapping, which the maps show is followed by free address space up
-    // to `region.end` (rounded to huge pages); the copy is made before the original is replaced, and the zygote
-    // runs one thread.
+    // to `region.start + region.len`; the caller vouches for the one thread.
     unsafe { replace_with_huge_copy(region) }?;
     Ok(Outcome::Moved(region.code_len))
 }

@@ -342,7 +342,8 @@ fn run_zygote(args: &ZygoteArgs) -> Result<()> {
     };
     install_stop_handler()?;
     let zygote = Zygote::prepare().context("preparing to fork agents")?;
-    match robot_agent::huge_text::move_code_to_huge_pages() {
+    // SAFETY: `Zygote::prepare` found this process with one thread, and it starts none before forking.
+    match unsafe { robot_agent::huge_text::move_code_to_huge_pages() } {
         Ok(outcome) => tracing::debug!(?outcome, "the agents' code"),
         Err(e) => tracing::warn!("the agents' code stays on small pages: {e}"),
     }

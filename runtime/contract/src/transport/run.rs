@@ -235,7 +235,7 @@ fn entries_of(dir: &Path) -> Result<Vec<Entry>, TransportError> {
     }
 }
 
-/// Removes `paths` (files, or folders with everything in them) from one thread per CPU; returns how many were
+/// Removes `entries` (files, or folders with everything in them) from one thread per CPU; returns how many were
 /// there. A run of 1,000 robots leaves about 15,000 entries, which one thread took 80 ms to remove, after the
 /// run, while the user waits.
 fn remove_in_parallel(entries: &[Entry]) -> Result<usize, TransportError> {
@@ -250,7 +250,11 @@ fn remove_in_parallel(entries: &[Entry]) -> Result<usize, TransportError> {
             .collect();
         workers
             .into_iter()
-            .map(|worker| worker.join().unwrap_or(Ok(0)))
+            .map(|worker| {
+                worker
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
             .sum()
     })
 }
