@@ -129,18 +129,12 @@ impl RunSpec {
         }
         doomed.extend(files);
         let mut removed = remove_in_parallel(&doomed)?;
-        let emptied = folders.into_iter().map(|folder| folder.path);
-        for folder in emptied.chain([self.root_dir.clone()]) {
-            match std::fs::remove_dir_all(&folder) {
-                Ok(()) => removed += 1,
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(source) => {
-                    return Err(TransportError::Cleanup {
-                        path: folder,
-                        source,
-                    });
-                }
-            }
+        let root = Entry {
+            path: self.root_dir.clone(),
+            is_dir: true,
+        };
+        for folder in folders.iter().chain([&root]) {
+            removed += remove_entry(folder)?;
         }
         Ok(removed)
     }
