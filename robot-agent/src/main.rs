@@ -26,7 +26,7 @@ use swarm_contract::protocol::launcher_to_agent::{
     AgentArgs, ZygoteArgs, ZygoteOrder, ZygoteReply,
 };
 use swarm_contract::protocol::resume::ResumePoint;
-use swarm_contract::transport::{AgentLink, RunSpec, TransportError};
+use swarm_contract::transport::{AgentLink, AgentNode, RunSpec, TransportError, WorldEnd};
 use tracing::{debug, info};
 
 /// One robot of a swarm run.
@@ -163,10 +163,22 @@ const JOIN_RETRY_PAUSE: Duration = Duration::from_millis(20);
 /// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports and
 /// the node place of the agent it replaces (iceoryx2 offers no notification of that), so an exhausted limit is
 /// retried for a while ([`Limits::agent_join_retry_ms`]).
-fn join(run: &RunSpec, robot: u32, limits: &Limits) -> Result<AgentLink> {
+fn join(run: &RunSpec, robot: u32, limits: &Limits, joining: Joining) -> Result<AgentLink> {
     let started = Instant::now();
+    let mut early_node = match joining {
+        Joining::FromZygote(node) => Some(node),
+        Joining::OnItsOwn => None,
+    };
+    let forked = early_node.is_some();
     loop {
-        match AgentLink::join_waiting(run, robot, limits.agent_board_wait()) {
+        let wait = limits.agent_board_wait();
+        let attempt = match early_node.take() {
+            Some(node) => AgentLink::join_on(run, node, wait, WorldEnd::ByParent),
+            None if forked => AgentNode::create(run, robot)
+                .and_then(|node| AgentLink::join_on(run, node, wait, WorldEnd::ByParent)),
+            None => AgentLink::join_waiting(run, robot, wait),
+        };
+        match attempt {
             Err(e) if limit_reached(&e) && started.elapsed() < limits.agent_join_retry() => {
                 std::thread::sleep(JOIN_RETRY_PAUSE);
             }
@@ -192,20 +204,30 @@ struct Seat<'a> {
     resume: Option<&'a Path>,
 }
 
+/// How an agent joins its run.
+enum Joining {
+    /// Started as a program of its own (by the launcher, a host, or by hand): it makes its node when it joins and
+    /// watches the world process itself.
+    OnItsOwn,
+    /// Forked by the zygote under `swarm run`: its node was made while the world got ready, and the launcher ends
+    /// it if the world dies ([`WorldEnd::ByParent`]).
+    FromZygote(AgentNode),
+}
+
 /// Answers every tick of the run until the world ends it.
-fn serve(seat: &Seat<'_>, control: &mut Control, limits: &Limits) -> Result<()> {
+fn serve(seat: &Seat<'_>, control: &mut Control, limits: &Limits, joining: Joining) -> Result<()> {
     let point = match seat.resume {
         Some(path) => Some(ResumePoint::read(path)?),
         None => None,
     };
     let mut resumer = Resumer::new(point);
-    let joining = Instant::now();
-    let mut link = join(seat.run, seat.slot, limits)?;
+    let join_started = Instant::now();
+    let mut link = join(seat.run, seat.slot, limits, joining)?;
     info!(
         run = seat.run.name(),
         robot = seat.robot,
         slot = seat.slot,
-        took = ?joining.elapsed(),
+        took = ?join_started.elapsed(),
         "joined the run"
     );
     match tick_loop(&mut link, control, &mut resumer, seat.robot)? {
@@ -298,7 +320,7 @@ fn run(args: &Args) -> Result<()> {
         slot: args.agent.slot.unwrap_or(args.agent.robot),
         resume: args.agent.resume.as_deref(),
     };
-    serve(&seat, &mut control, &limits)
+    serve(&seat, &mut control, &limits, Joining::OnItsOwn)
         .with_context(|| format!("robot {} in run {}", args.agent.robot, args.agent.run))
 }
 
@@ -409,10 +431,12 @@ fn agent_from_zygote(
         })
         .with_context(|| format!("robot {}: cannot start its controller", seat.robot))
         .and_then(|(_, mut control)| {
+            // The node needs only the run's iceoryx2 root: made now, it is ready when the world is.
+            let node = AgentNode::create(seat.run, seat.slot)?;
             zygote
                 .wait_for_the_run()
                 .context("waiting for the run's shared memory")?;
-            serve(seat, &mut control, limits)
+            serve(seat, &mut control, limits, Joining::FromZygote(node))
                 .with_context(|| format!("robot {} in run {}", seat.robot, seat.run.name()))
         });
     exit_code(served)

@@ -22,7 +22,7 @@ use iceoryx2::prelude::{ZeroCopySend, ipc};
 use super::TransportError;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
-use super::sync_block::{JoinClaim, SyncBlock};
+use super::sync_block::{JoinClaim, SyncBlock, WorldEndCheck};
 use super::world_watch::WorldWatch;
 use super::{placement, priority};
 use crate::mail::Mailbox;
@@ -138,6 +138,66 @@ type OwnEntry<T> = (
     EntryHandle<ipc::Service, u32, T>,
 );
 
+/// A robot's iceoryx2 node in a run, made before the agent joins (see [`AgentLink::join_on`]). A node needs only the
+/// run's iceoryx2 root, not the world's services, so an agent started before the world is ready makes it while it
+/// waits instead of after (docs/transport.md, "Starting the agents").
+pub struct AgentNode {
+    robot: u32,
+    node: Node<ipc::Service>,
+}
+
+impl AgentNode {
+    /// Creates the node of robot `robot`'s agent in `run`.
+    pub fn create(run: &RunSpec, robot: u32) -> Result<AgentNode, TransportError> {
+        let node = services::node(run, &format!("robot-{robot}"))?;
+        Ok(AgentNode { robot, node })
+    }
+}
+
+/// Who ends an agent whose world process ends without stopping the run (killed, or crashed).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorldEnd {
+    /// The agent itself: a thread of the agent watches the world process and wakes the agent, whose wait then
+    /// fails with [`TransportError::WorldGone`]. For agents started by hand or by a host.
+    Watched,
+    /// The agent's parent: `swarm run`'s launcher kills every agent when its world dies, and the kernel kills the
+    /// agents of a launcher that dies (`PR_SET_PDEATHSIG`). The agent then starts no thread of its own (creating
+    /// and ending it cost about 60 us per agent) and sleeps without a timer.
+    ByParent,
+}
+
+/// How an agent's waits notice the end of the world process.
+enum WorldEndNotice {
+    /// The agent's watch thread sets a flag and wakes the agent.
+    Thread(WorldWatch),
+    /// Watched on a kernel without pidfds: the waits check the process every second of silence.
+    Poll,
+    /// The agent's parent ends it ([`WorldEnd::ByParent`]).
+    Parent,
+}
+
+impl WorldEndNotice {
+    fn start(world_end: WorldEnd, sync: &Arc<SyncBlock>, robot: u32) -> WorldEndNotice {
+        if world_end == WorldEnd::ByParent {
+            return WorldEndNotice::Parent;
+        }
+        let watched = Arc::clone(sync);
+        match WorldWatch::start(sync.world_pid(), move || watched.nudge(robot)) {
+            Some(watch) => WorldEndNotice::Thread(watch),
+            None => WorldEndNotice::Poll,
+        }
+    }
+
+    #[unsafe(link_section = "swarm_hot")]
+    fn check(&self) -> WorldEndCheck<'_> {
+        match self {
+            WorldEndNotice::Thread(watch) => WorldEndCheck::Flag(watch.gone()),
+            WorldEndNotice::Poll => WorldEndCheck::Poll,
+            WorldEndNotice::Parent => WorldEndCheck::None,
+        }
+    }
+}
+
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
@@ -152,8 +212,8 @@ pub struct AgentLink {
     mail: Box<Mail>,
     ports: Ports,
     sync: Arc<SyncBlock>,
-    /// Notices the end of the world process, so that waits need no timeout (`None`: no pidfd here).
-    world_watch: Option<WorldWatch>,
+    /// Notices the end of the world process, so that waits need no timeout where it can.
+    world_end: WorldEndNotice,
 }
 
 impl AgentLink {
@@ -174,6 +234,27 @@ impl AgentLink {
         robot: u32,
         board_wait: Duration,
     ) -> Result<AgentLink, TransportError> {
+        AgentLink::join_with(run, robot, None, board_wait, WorldEnd::Watched)
+    }
+
+    /// Joins `run` as the agent of `node`'s robot on that node, as [`AgentLink::join_waiting`] does on a node of
+    /// its own; `world_end` says who ends the agent if the world process ends without stopping the run.
+    pub fn join_on(
+        run: &RunSpec,
+        node: AgentNode,
+        board_wait: Duration,
+        world_end: WorldEnd,
+    ) -> Result<AgentLink, TransportError> {
+        AgentLink::join_with(run, node.robot, Some(node.node), board_wait, world_end)
+    }
+
+    fn join_with(
+        run: &RunSpec,
+        robot: u32,
+        node: Option<Node<ipc::Service>>,
+        board_wait: Duration,
+        world_end: WorldEnd,
+    ) -> Result<AgentLink, TransportError> {
         let sync = Arc::new(SyncBlock::open(&run.sync_block_path())?);
         let capacity = sync.capacity();
         if robot >= capacity {
@@ -182,7 +263,7 @@ impl AgentLink {
         if let JoinClaim::Taken = sync.claim_robot(robot, Instant::now() + board_wait) {
             return Err(TransportError::RobotTaken { robot });
         }
-        match Self::connect(run, robot, &sync, board_wait) {
+        match Self::connect(run, robot, node, &sync, board_wait) {
             Ok((ports, mail_ports)) => {
                 let has_mail = mail_ports.is_some();
                 let mail = Box::new(Mail {
@@ -202,8 +283,7 @@ impl AgentLink {
                 }
                 // A replacement agent must not answer a tick its predecessor already answered.
                 let last_tick = sync.tick();
-                let watched = Arc::clone(&sync);
-                let world_watch = WorldWatch::start(sync.world_pid(), move || watched.nudge(robot));
+                let world_end = WorldEndNotice::start(world_end, &sync, robot);
                 if placement.realtime
                     && let Err(e) = priority::enter_realtime(priority::AGENT_PRIORITY)
                 {
@@ -217,7 +297,7 @@ impl AgentLink {
                     frame: SensorFrame::empty(robot),
                     ports,
                     sync,
-                    world_watch,
+                    world_end,
                     has_mail,
                     mail,
                 })
@@ -232,6 +312,7 @@ impl AgentLink {
     fn connect(
         run: &RunSpec,
         robot: u32,
+        node: Option<Node<ipc::Service>>,
         sync: &SyncBlock,
         board_wait: Duration,
     ) -> Result<(Ports, Option<MailPorts>), TransportError> {
@@ -246,7 +327,10 @@ impl AgentLink {
                     waited_ms: waited.elapsed().as_millis(),
                 })?;
         sync.mark_used(robot);
-        let node = services::node(run, &format!("robot-{robot}"))?;
+        let node = match node {
+            Some(node) => node,
+            None => AgentNode::create(run, robot)?.node,
+        };
         let (frame_board, frame_reader, frame_entry) = Self::read_own_entry::<SensorFrame>(
             &node,
             &services::frame_service_name(),
@@ -372,9 +456,8 @@ impl AgentLink {
                     return Ok(Some(Tick { link: self }));
                 }
             }
-            let world_gone = self.world_watch.as_ref().map(WorldWatch::gone);
             self.sync
-                .wait_chain(self.robot, seen, self.spin, world_gone)
+                .wait_chain(self.robot, seen, self.spin, self.world_end.check())
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }

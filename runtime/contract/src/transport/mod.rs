@@ -25,7 +25,7 @@ mod world_watch;
 use std::path::PathBuf;
 use std::process::Command;
 
-pub use agent::{AgentLink, Tick};
+pub use agent::{AgentLink, AgentNode, Tick, WorldEnd};
 pub use run::{RUN_ROOTS_DIR, RunSpec};
 pub use sync_block::MAX_ROBOTS;
 pub use world::{

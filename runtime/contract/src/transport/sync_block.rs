@@ -124,6 +124,18 @@ unsafe impl Send for SyncBlock {}
 // SAFETY: as above; every access is an atomic operation.
 unsafe impl Sync for SyncBlock {}
 
+/// How [`SyncBlock::wait_chain`] learns that the world process ended without stopping the run.
+#[derive(Clone, Copy)]
+pub(crate) enum WorldEndCheck<'a> {
+    /// A flag that a [`WorldWatch`](super::world_watch::WorldWatch) sets when it changes the wake word: sleep
+    /// without a timeout.
+    Flag(&'a AtomicBool),
+    /// Nothing watches: check every [`WORLD_CHECK`] of silence that the world process still exists.
+    Poll,
+    /// Not the agent's business: its parent ends it with the world. Sleep without a timeout.
+    None,
+}
+
 /// Whether a robot could be claimed by a new agent.
 pub(crate) enum JoinClaim {
     /// The robot is now owned by the caller.
@@ -647,16 +659,14 @@ impl SyncBlock {
 
     /// Waits until the wake word of `robot`'s chain differs from `seen` (a tick started, or the end of the run),
     /// polling `spin` times before blocking; `Err(pid)` when the world process is gone (killed without stopping
-    /// the run). With `world_gone` (set by a [`WorldWatch`](super::world_watch::WorldWatch), which also changes
-    /// the wake word) it sleeps without a timeout; without, it checks every [`WORLD_CHECK`] of silence that the
-    /// world process still exists.
+    /// the run), as far as `world_end` tells.
     #[unsafe(link_section = "swarm_hot")]
     pub(crate) fn wait_chain(
         &self,
         robot: u32,
         seen: u32,
         spin: u32,
-        world_gone: Option<&AtomicBool>,
+        world_end: WorldEndCheck<'_>,
     ) -> Result<(), u32> {
         let go = &self.slot(self.chain_of(robot)).chain_go;
         for _ in 0..spin {
@@ -666,13 +676,13 @@ impl SyncBlock {
             std::hint::spin_loop();
         }
         while go.load(Ordering::Acquire) == seen {
-            let gone = match world_gone {
-                Some(gone) if gone.load(Ordering::Acquire) => true,
-                Some(_) => {
+            let gone = match world_end {
+                WorldEndCheck::Flag(gone) if gone.load(Ordering::Acquire) => true,
+                WorldEndCheck::Flag(_) | WorldEndCheck::None => {
                     futex::wait(go, seen, None);
                     false
                 }
-                None => {
+                WorldEndCheck::Poll => {
                     futex::wait(go, seen, Some(WORLD_CHECK)) == futex::Waited::TimedOut
                         && !self.world_alive()
                 }
