@@ -3,8 +3,10 @@
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+use swarm_contract::messages::ActuatorCommand;
 use swarm_contract::transport::{
-    AgentLink, CommandStatus, LinkConfig, RunSpec, TransportError, WorldLink, priority,
+    AgentLink, AgentNode, CommandStatus, LinkConfig, RunSpec, TransportError, WorldEnd, WorldLink,
+    priority,
 };
 
 const AGENT: &str = env!("CARGO_BIN_EXE_swarm-lockstep-agent");
@@ -93,6 +95,44 @@ fn every_agent_receives_its_own_frame_and_answers_into_its_own_slot() {
         for robot in 0..8 {
             expect_echo(&world, robot, tick);
         }
+    }
+}
+
+#[test]
+fn agents_whose_nodes_were_made_before_the_world_existed_join_on_them() {
+    let run = Run::new();
+    // As the zygote's agents do: nodes made before the world has created anything of the run.
+    let nodes: Vec<AgentNode> = (0..2)
+        .map(|robot| AgentNode::create(&run.spec, robot).expect("a node before the world"))
+        .collect();
+    let mut world = WorldLink::create(&run.spec, config(2, 10_000)).expect("create world");
+    let agents: Vec<_> = nodes
+        .into_iter()
+        .zip(0..)
+        .map(|(node, robot)| {
+            let spec = run.spec.clone();
+            std::thread::spawn(move || {
+                let mut link = AgentLink::join_on(&spec, node, JOIN_TIMEOUT, WorldEnd::ByParent)
+                    .expect("joins on its node");
+                let tick = link.next_tick().expect("a tick").expect("the run goes on");
+                let mut command = ActuatorCommand::idle(robot, tick.number());
+                command.wheels = tick.frame().position;
+                tick.answer(&mut command);
+                let next = link.next_tick().expect("the end of the run");
+                assert!(next.is_none(), "the world ended the run after one tick");
+                link.release_ended_run();
+            })
+        })
+        .collect();
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    let outcome = world.tick_with(sense).expect("tick");
+    assert_eq!(outcome.answered, 2, "{outcome:?}");
+    for robot in 0..2 {
+        expect_echo(&world, robot, 1);
+    }
+    drop(world);
+    for agent in agents {
+        agent.join().expect("the agent's thread");
     }
 }
 
