@@ -382,7 +382,7 @@ fn run_zygote(args: &ZygoteArgs) -> Result<()> {
                 let controller = controller_of(order.robot);
                 let code =
                     agent_from_zygote(&zygote, &experiment, controller, args, &limits, &seat);
-                std::process::exit(code);
+                zygote.exit_agent(code);
             }
             Ok(Forked::Zygote(pid)) => ZygoteReply::Started {
                 robot: order.robot,

@@ -301,9 +301,14 @@ impl FromStr for ZygoteReply {
 
 /// Starts the agent zygote `program zygote <args>` with the process settings every agent gets, its standard input
 /// and output piped (orders in, replies out) and its standard error into `log`.
+///
+/// `LD_BIND_NOW=1` has the dynamic loader bind every symbol of the shared libraries (glibc's among them binds
+/// lazily) once, when the zygote starts, instead of each forked agent running the loader's symbol lookup on its
+/// first call of each function and copying the page it patched (docs/transport.md, "Starting the agents").
 pub fn start_zygote(program: &Path, args: &ZygoteArgs, log: File) -> std::io::Result<Child> {
     children::spawn(
         tune_agent_command(&mut Command::new(program))
+            .env("LD_BIND_NOW", "1")
             .arg("zygote")
             .args(args.to_args())
             .stdin(Stdio::piped())
