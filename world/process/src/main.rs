@@ -142,12 +142,14 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
         &limits,
     )?
     .with_arrivals(faults::Arrivals::new(&experiment));
-    let mut recorder = Recorder::create(&args.out, &world, &[0], args.records)?;
-    let mut post = PostOffice::new(&world, link.robots());
-    recorder.record(&mut world)?;
+    // The agents may join as soon as the link exists: they join while the record files and the first snapshot
+    // are made.
     report(WorldReport::Ready {
         robots: robots as u32,
     });
+    let mut recorder = Recorder::create(&args.out, &world, &[0], args.records)?;
+    let mut post = PostOffice::new(&world, link.robots());
+    recorder.record(&mut world)?;
 
     let mut commands: Vec<ActuatorCommand> = (0..robots)
         .map(|i| ActuatorCommand::idle(i as u32, 0))
