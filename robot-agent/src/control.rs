@@ -9,7 +9,7 @@ use swarm_contract::messages::{ActuatorCommand, SensorFrame};
 use swarm_contract::player::{Player, PlayerError};
 use swarm_contract::supervisor_gen::compiled::SupervisorSet;
 use thiserror::Error;
-use tracing::info;
+use tracing::debug;
 
 use crate::binding::Talk;
 use crate::controller::{Plan, Supervisors};
@@ -135,7 +135,7 @@ pub fn build(
             let set = load_set(supervisors, *reduce)?;
             let params = params.clone().with_run_seed(run_seed);
             let callbacks = profiles::bind_profile(profile, &params, &set.events)?;
-            info!(
+            debug!(
                 profile = profile.as_str(),
                 supervisors = where_.as_str(),
                 count = set.supervisors.len(),
@@ -154,7 +154,7 @@ pub fn build(
         }
         Plan::Native { name } => {
             let controller = native::build_native(name, &params.clone().with_run_seed(run_seed))?;
-            info!(native = name.as_str(), "native controller built");
+            debug!(native = name.as_str(), "native controller built");
             Ok(Control::Native(controller))
         }
     }
