@@ -163,22 +163,10 @@ const JOIN_RETRY_PAUSE: Duration = Duration::from_millis(20);
 /// Joins the run. A replacement agent can start before the world's dead-node cleanup has freed the ports and
 /// the node place of the agent it replaces (iceoryx2 offers no notification of that), so an exhausted limit is
 /// retried for a while ([`Limits::agent_join_retry_ms`]).
-fn join(run: &RunSpec, robot: u32, limits: &Limits, joining: Joining) -> Result<AgentLink> {
+fn join(run: &RunSpec, robot: u32, limits: &Limits, mut joining: Joining) -> Result<AgentLink> {
     let started = Instant::now();
-    let mut early_node = match joining {
-        Joining::FromZygote(node) => Some(node),
-        Joining::OnItsOwn => None,
-    };
-    let forked = early_node.is_some();
     loop {
-        let wait = limits.agent_board_wait();
-        let attempt = match early_node.take() {
-            Some(node) => AgentLink::join_on(run, node, wait, WorldEnd::ByParent),
-            None if forked => AgentNode::create(run, robot)
-                .and_then(|node| AgentLink::join_on(run, node, wait, WorldEnd::ByParent)),
-            None => AgentLink::join_waiting(run, robot, wait),
-        };
-        match attempt {
+        match joining.attempt(run, robot, limits.agent_board_wait()) {
             Err(e) if limit_reached(&e) && started.elapsed() < limits.agent_join_retry() => {
                 std::thread::sleep(JOIN_RETRY_PAUSE);
             }
@@ -209,9 +197,30 @@ enum Joining {
     /// Started as a program of its own (by the launcher, a host, or by hand): it makes its node when it joins and
     /// watches the world process itself.
     OnItsOwn,
-    /// Forked by the zygote under `swarm run`: its node was made while the world got ready, and the launcher ends
-    /// it if the world dies ([`WorldEnd::ByParent`]).
-    FromZygote(AgentNode),
+    /// Forked by the zygote under `swarm run`: the launcher ends it if the world dies ([`WorldEnd::ByParent`]). The
+    /// node made while the world got ready is used by the first attempt; a retry makes a new one.
+    FromZygote(Option<AgentNode>),
+}
+
+impl Joining {
+    /// One attempt to join robot `robot` of `run`.
+    fn attempt(
+        &mut self,
+        run: &RunSpec,
+        robot: u32,
+        board_wait: Duration,
+    ) -> Result<AgentLink, TransportError> {
+        match self {
+            Joining::OnItsOwn => AgentLink::join_waiting(run, robot, board_wait),
+            Joining::FromZygote(early_node) => {
+                let node = match early_node.take() {
+                    Some(node) => node,
+                    None => AgentNode::create(run, robot)?,
+                };
+                AgentLink::join_on(run, node, board_wait, WorldEnd::ByParent)
+            }
+        }
+    }
 }
 
 /// Answers every tick of the run until the world ends it.
@@ -436,7 +445,7 @@ fn agent_from_zygote(
             zygote
                 .wait_for_the_run()
                 .context("waiting for the run's shared memory")?;
-            serve(seat, &mut control, limits, Joining::FromZygote(node))
+            serve(seat, &mut control, limits, Joining::FromZygote(Some(node)))
                 .with_context(|| format!("robot {} in run {}", seat.robot, seat.run.name()))
         });
     exit_code(served)

@@ -22,8 +22,8 @@ use iceoryx2::prelude::{ZeroCopySend, ipc};
 use super::TransportError;
 use super::run::RunSpec;
 use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
-use super::sync_block::{JoinClaim, SyncBlock, WorldEndCheck};
-use super::world_watch::WorldWatch;
+use super::sync_block::{JoinClaim, SyncBlock};
+use super::world_watch::WorldEndNotice;
 use super::{placement, priority};
 use crate::mail::Mailbox;
 use crate::messages::{ActuatorCommand, SensorFrame};
@@ -166,38 +166,6 @@ pub enum WorldEnd {
     ByParent,
 }
 
-/// How an agent's waits notice the end of the world process.
-enum WorldEndNotice {
-    /// The agent's watch thread sets a flag and wakes the agent.
-    Thread(WorldWatch),
-    /// Watched on a kernel without pidfds: the waits check the process every second of silence.
-    Poll,
-    /// The agent's parent ends it ([`WorldEnd::ByParent`]).
-    Parent,
-}
-
-impl WorldEndNotice {
-    fn start(world_end: WorldEnd, sync: &Arc<SyncBlock>, robot: u32) -> WorldEndNotice {
-        if world_end == WorldEnd::ByParent {
-            return WorldEndNotice::Parent;
-        }
-        let watched = Arc::clone(sync);
-        match WorldWatch::start(sync.world_pid(), move || watched.nudge(robot)) {
-            Some(watch) => WorldEndNotice::Thread(watch),
-            None => WorldEndNotice::Poll,
-        }
-    }
-
-    #[unsafe(link_section = "swarm_hot")]
-    fn check(&self) -> WorldEndCheck<'_> {
-        match self {
-            WorldEndNotice::Thread(watch) => WorldEndCheck::Flag(watch.gone()),
-            WorldEndNotice::Poll => WorldEndCheck::Poll,
-            WorldEndNotice::Parent => WorldEndCheck::None,
-        }
-    }
-}
-
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
@@ -283,7 +251,13 @@ impl AgentLink {
                 }
                 // A replacement agent must not answer a tick its predecessor already answered.
                 let last_tick = sync.tick();
-                let world_end = WorldEndNotice::start(world_end, &sync, robot);
+                let world_end = match world_end {
+                    WorldEnd::ByParent => WorldEndNotice::Parent,
+                    WorldEnd::Watched => {
+                        let watched = Arc::clone(&sync);
+                        WorldEndNotice::watch(sync.world_pid(), move || watched.nudge(robot))
+                    }
+                };
                 if placement.realtime
                     && let Err(e) = priority::enter_realtime(priority::AGENT_PRIORITY)
                 {
@@ -457,7 +431,7 @@ impl AgentLink {
                 }
             }
             self.sync
-                .wait_chain(self.robot, seen, self.spin, self.world_end.check())
+                .wait_chain(self.robot, seen, self.spin, &self.world_end)
                 .map_err(|pid| TransportError::WorldGone { pid })?;
         }
     }

@@ -23,11 +23,12 @@ use std::fs::OpenOptions;
 use std::os::fd::AsRawFd;
 use std::path::{Path, PathBuf};
 use std::ptr::NonNull;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use super::TransportError;
 use super::futex::{self, LineWord};
+use super::world_watch::WorldEndNotice;
 
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
@@ -123,18 +124,6 @@ pub(crate) struct SyncBlock {
 unsafe impl Send for SyncBlock {}
 // SAFETY: as above; every access is an atomic operation.
 unsafe impl Sync for SyncBlock {}
-
-/// How [`SyncBlock::wait_chain`] learns that the world process ended without stopping the run.
-#[derive(Clone, Copy)]
-pub(crate) enum WorldEndCheck<'a> {
-    /// A flag that a [`WorldWatch`](super::world_watch::WorldWatch) sets when it changes the wake word: sleep
-    /// without a timeout.
-    Flag(&'a AtomicBool),
-    /// Nothing watches: check every [`WORLD_CHECK`] of silence that the world process still exists.
-    Poll,
-    /// Not the agent's business: its parent ends it with the world. Sleep without a timeout.
-    None,
-}
 
 /// Whether a robot could be claimed by a new agent.
 pub(crate) enum JoinClaim {
@@ -666,7 +655,7 @@ impl SyncBlock {
         robot: u32,
         seen: u32,
         spin: u32,
-        world_end: WorldEndCheck<'_>,
+        world_end: &WorldEndNotice,
     ) -> Result<(), u32> {
         let go = &self.slot(self.chain_of(robot)).chain_go;
         for _ in 0..spin {
@@ -677,12 +666,12 @@ impl SyncBlock {
         }
         while go.load(Ordering::Acquire) == seen {
             let gone = match world_end {
-                WorldEndCheck::Flag(gone) if gone.load(Ordering::Acquire) => true,
-                WorldEndCheck::Flag(_) | WorldEndCheck::None => {
+                WorldEndNotice::Thread(watch) if watch.gone().load(Ordering::Acquire) => true,
+                WorldEndNotice::Thread(_) | WorldEndNotice::Parent => {
                     futex::wait(go, seen, None);
                     false
                 }
-                WorldEndCheck::Poll => {
+                WorldEndNotice::Poll => {
                     futex::wait(go, seen, Some(WORLD_CHECK)) == futex::Waited::TimedOut
                         && !self.world_alive()
                 }

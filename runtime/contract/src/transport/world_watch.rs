@@ -4,7 +4,9 @@
 //! tick (the bare lockstep at N = 1,000 had a ~3 % lower tick p50 without it, BENCHMARKS.md), so agents sleep
 //! without a timeout and a thread of their own watches the world instead: it blocks in poll(2) on a pidfd of the
 //! world process, and when the world ends it sets [`WorldWatch::gone`] and calls the agent's wake-up. Where no
-//! pidfd can be had (kernels before 5.3), [`WorldWatch::start`] returns `None` and the caller keeps a timed wait.
+//! pidfd can be had (kernels before 5.3), [`WorldWatch::start`] returns `None` and the agent keeps a timed wait
+//! ([`WorldEndNotice::Poll`]). An agent whose parent ends it with the world needs neither
+//! ([`WorldEndNotice::Parent`]).
 
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::sync::Arc;
@@ -13,6 +15,24 @@ use std::thread::JoinHandle;
 
 /// The watching thread's stack: it only polls, and an agent should not pay a default 2 MiB reservation for it.
 const WATCH_STACK: usize = 64 * 1024;
+
+/// How an agent's waits notice the end of the world process ([`SyncBlock::wait_chain`](super::sync_block::SyncBlock::wait_chain)).
+pub(crate) enum WorldEndNotice {
+    /// The agent's watch thread sets a flag and wakes the agent: it sleeps without a timeout.
+    Thread(WorldWatch),
+    /// Watched on a kernel without pidfds: the waits check the process every second of silence.
+    Poll,
+    /// The agent's parent ends it with the world: it sleeps without a timeout and checks nothing.
+    Parent,
+}
+
+impl WorldEndNotice {
+    /// Watches process `pid` from a thread that calls `wake` when it ends; [`WorldEndNotice::Poll`] where no
+    /// pidfd can be had.
+    pub(crate) fn watch(pid: u32, wake: impl FnOnce() + Send + 'static) -> WorldEndNotice {
+        WorldWatch::start(pid, wake).map_or(WorldEndNotice::Poll, WorldEndNotice::Thread)
+    }
+}
 
 /// A thread that waits for one process to end.
 pub(crate) struct WorldWatch {
