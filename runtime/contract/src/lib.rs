@@ -21,6 +21,7 @@
 
 pub mod alloc_count;
 pub mod bodies;
+mod compact_encoding;
 pub mod config;
 pub mod cpu;
 pub mod disk_budget;

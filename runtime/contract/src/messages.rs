@@ -11,7 +11,8 @@
 //! which is part of every service name, so processes built from different versions never connect.
 //!
 //! Across hosts the same types travel bincode-encoded (`Encode`/`Decode`, field by field, little-endian), never
-//! as raw memory, so hosts of different architectures interoperate (see `remote::codec`).
+//! as raw memory, so hosts of different architectures interoperate (see `remote::codec`); frames and commands
+//! leave out the unused ends of their arrays (`crate::compact_encoding`).
 
 use bincode::{Decode, Encode};
 use iceoryx2::prelude::ZeroCopySend;
@@ -96,7 +97,8 @@ pub struct RabMessage {
 }
 
 /// Everything one robot senses in one tick. Written by the world, read by the robot's agent.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+// Encode and Decode: crate::compact_encoding.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
 pub struct SensorFrame {
     /// Tick this frame belongs to (1 for the first tick).
@@ -305,7 +307,8 @@ pub struct FiredStamp {
 }
 
 /// The state of a robot's supervisors after a player step: enough to record and to resume them exactly.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+// Encode and Decode: crate::compact_encoding.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
 pub struct SupervisorSnapshot {
     /// Number of supervisors in use.
@@ -333,7 +336,8 @@ impl Default for SupervisorSnapshot {
 }
 
 /// Everything one robot commands in one tick, plus what it did. Written by the agent, read by the world.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, Encode, Decode)]
+// Encode and Decode: crate::compact_encoding.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]
 pub struct ActuatorCommand {
     /// Tick this command answers (equal to the frame's tick).

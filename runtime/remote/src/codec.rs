@@ -16,10 +16,13 @@ use swarm_contract::messages::MESSAGE_VERSION;
 
 /// First field of every message: `SWRM` read as a little-endian u32.
 pub const WIRE_MAGIC: u32 = u32::from_le_bytes(*b"SWRM");
-/// Version of the wire format; it follows the message layout version, so hosts built from different message
-/// layouts reject each other's payloads instead of misreading them.
-pub const WIRE_VERSION: u32 = MESSAGE_VERSION;
-/// Default largest payload accepted (bytes): far above 1,000 robots' frames (~0.6 kB each).
+/// Revision of the encoding within one message layout: 2 since frames and commands leave out the unused ends of
+/// their arrays (`swarm_contract`'s `compact_encoding`).
+const WIRE_REVISION: u32 = 2;
+/// Version of the wire format: the message layout version and the encoding's revision, so hosts built from
+/// different message layouts or encodings reject each other's payloads instead of misreading them.
+pub const WIRE_VERSION: u32 = MESSAGE_VERSION << 8 | WIRE_REVISION;
+/// Default largest payload accepted (bytes): far above 1,000 robots' frames (at most about 0.8 kB each).
 pub const DEFAULT_MAX_PAYLOAD: usize = 16 << 20;
 
 /// The bincode configuration of every cross-host message.
