@@ -22,6 +22,30 @@ pub const DEFAULT_LEASE: Duration = Duration::from_secs(1);
 const MAX_CREDENTIALS_BYTES: u64 = 1 << 20;
 /// Default endpoint the world listens on (loopback only).
 pub const DEFAULT_LISTEN: &str = "tcp/127.0.0.1:7447";
+/// The environment variable zenoh reads the layout of its async runtimes from.
+pub const ZENOH_RUNTIME_ENV: &str = "ZENOH_RUNTIME";
+/// zenoh's receiving, sending, accepting and network work handed over to its application runtime, which has one
+/// worker thread.
+const ONE_RUNTIME: &str =
+    "(rx: (handover: app), tx: (handover: app), acc: (handover: app), net: (handover: app))";
+
+/// Makes zenoh run all its work on one thread unless `ZENOH_RUNTIME` already says otherwise.
+///
+/// By default zenoh spreads its work over five runtimes with six threads. A batch then crossed two threads on its
+/// way in (the thread watching the socket handed it to a receiving worker, which also woke the second receiving
+/// worker) and one on its way out, each a wake-up of some 20 us on the critical path of every tick. On one
+/// thread the thread that sees the socket readable reads the batch and runs the callback. docs/hosts.md,
+/// "Latency", has the measurement.
+///
+/// # Safety
+///
+/// It sets an environment variable: call it before the process starts its second thread.
+pub unsafe fn run_zenoh_on_one_thread() {
+    if std::env::var_os(ZENOH_RUNTIME_ENV).is_none() {
+        // SAFETY: the caller guarantees that no other thread runs yet.
+        unsafe { std::env::set_var(ZENOH_RUNTIME_ENV, ONE_RUNTIME) };
+    }
+}
 
 /// What every zenoh session of a multi-host run is configured with.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -55,6 +55,8 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
+    // SAFETY: the process has one thread here.
+    unsafe { swarm_remote::session::run_zenoh_on_one_thread() };
     swarm_contract::logging::init("info");
     let cli = Cli::parse();
     match run(&cli.args, &cli.hosts) {

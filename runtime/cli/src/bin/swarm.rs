@@ -337,6 +337,8 @@ struct HostCli {
 const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
+    // SAFETY: the process has one thread here.
+    unsafe { swarm_remote::session::run_zenoh_on_one_thread() };
     swarm_contract::logging::init("info");
     match run(Cli::parse()) {
         Ok(code) => code,
