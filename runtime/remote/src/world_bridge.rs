@@ -205,6 +205,9 @@ pub struct RemoteHosts {
     status: Vec<CommandStatus>,
     /// Index in `hosts` of each robot's host.
     owner: Vec<usize>,
+    /// Whether every host's robots are one range of ids and the ranges cover all robots (as the launcher's
+    /// placement makes them): then each host's frames are sensed and sent before the next host's are sensed.
+    sensed_by_host: bool,
     /// Per robot: its host runs an agent for it, as far as the world knows.
     present: Vec<bool>,
     /// Per robot: an order made its host stop waiting for it (killed, frozen, missed a deadline).
@@ -332,7 +335,9 @@ impl RemoteHosts {
                 }
             }
         }
+        let sensed_by_host = shares_cover_in_ranges(&options.hosts, robots);
         Ok(RemoteHosts {
+            sensed_by_host,
             options,
             session,
             run,
@@ -441,9 +446,10 @@ impl RemoteHosts {
         self.tick
     }
 
-    /// Runs one tick: `sense(tick, 0, frames)` fills every robot's frame (the arguments of
-    /// `WorldLink::tick_with`, with all robots at once), one message per live host goes out, and the call
-    /// returns when every live host answered or the deadline passed. Read the commands with
+    /// Runs one tick: `sense(tick, first, frames)` fills the frames of robots `first..` (the arguments of
+    /// `WorldLink::tick_with`), one host's robots at a time when the placement gives each host a range of ids
+    /// (else all robots at once), and each live host's message goes out as soon as its frames are sensed; the
+    /// call returns when every live host answered or the deadline passed. Read the commands with
     /// [`RemoteHosts::command`].
     pub fn tick_with(
         &mut self,
@@ -456,11 +462,20 @@ impl RemoteHosts {
             self.handle(event, false)?;
         }
         self.retry_assignments()?;
-        SensorFrame::sense_into(tick, 0, &mut self.frames, &mut sense);
+        if !self.sensed_by_host {
+            SensorFrame::sense_into(tick, 0, &mut self.frames, &mut sense);
+        }
         for status in &mut self.status {
             *status = CommandStatus::Missing;
         }
         for (index, host) in self.hosts.iter_mut().enumerate() {
+            if self.sensed_by_host
+                && let Some(&first) = host.share.robots.first()
+            {
+                // The host's agents start while the world senses the next host's robots.
+                let range = first as usize..first as usize + host.share.robots.len();
+                SensorFrame::sense_into(tick, range.start, &mut self.frames[range], &mut sense);
+            }
             if host.state != State::Live || host.live_from > tick {
                 continue;
             }
@@ -1000,6 +1015,21 @@ impl RemoteHosts {
     }
 }
 
+/// Whether the robots of `hosts` are, host by host, consecutive ids whose ranges together are exactly `0..robots`.
+fn shares_cover_in_ranges(hosts: &[HostShare], robots: u32) -> bool {
+    let mut covered = vec![false; robots as usize];
+    for share in hosts {
+        let first = share.robots.first().copied().unwrap_or(0);
+        for (offset, &robot) in (0..).zip(&share.robots) {
+            match covered.get_mut(robot as usize) {
+                Some(seen) if !*seen && robot == first + offset => *seen = true,
+                _ => return false,
+            }
+        }
+    }
+    covered.into_iter().all(|seen| seen)
+}
+
 #[cfg(test)]
 mod tests {
     //! The world's side against fake hosts: real zenoh sessions on loopback, hosts played by the test.
@@ -1011,6 +1041,39 @@ mod tests {
     use crate::auth::HostKey;
     use crate::host_to_world::without_outboxes;
     use crate::world_to_host::FrameEntry;
+
+    fn shares(robots: &[&[u32]]) -> Vec<HostShare> {
+        robots
+            .iter()
+            .enumerate()
+            .map(|(i, robots)| HostShare {
+                name: format!("h{i}"),
+                robots: robots.to_vec(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn hosts_are_sensed_one_by_one_only_when_their_ranges_cover_the_robots() {
+        assert!(shares_cover_in_ranges(&shares(&[&[0, 1], &[2, 3, 4]]), 5));
+        assert!(shares_cover_in_ranges(&shares(&[&[3, 4], &[0, 1, 2]]), 5));
+        assert!(
+            !shares_cover_in_ranges(&shares(&[&[0, 2], &[1, 3]]), 4),
+            "not ranges"
+        );
+        assert!(
+            !shares_cover_in_ranges(&shares(&[&[0, 1], &[3]]), 4),
+            "robot 2 on no host"
+        );
+        assert!(
+            !shares_cover_in_ranges(&shares(&[&[0, 1], &[1, 2]]), 3),
+            "robot 1 twice"
+        );
+        assert!(
+            !shares_cover_in_ranges(&shares(&[&[0, 1, 2]]), 2),
+            "robot 2 is not in the run"
+        );
+    }
 
     /// How a fake host answers frames.
     #[derive(Clone, Copy)]
