@@ -373,7 +373,7 @@ fn network_corpus() -> Vec<(String, Vec<u8>)> {
     vec![
         (
             "assignment".into(),
-            codec::encode_message(&assignment).expect("encodes"),
+            codec::encode_versioned(&assignment).expect("encodes"),
         ),
         (
             "order".into(),
@@ -416,7 +416,7 @@ fn network_messages_decode_or_are_refused_and_no_altered_message_passes_its_tag(
     }
     let max = DEFAULT_MAX_PAYLOAD;
     fuzz(&corpus, &[&[0xff; 9], &[0; 9], &[0x80]], |_, bytes| {
-        let _ = codec::decode_message::<Assignment>(bytes, max);
+        let _ = codec::decode_versioned::<Assignment>(bytes, max);
         let _ = codec::decode_message::<Order>(bytes, max);
         let _ = codec::decode_message::<AssignmentReply>(bytes, max);
         let _ = codec::decode_message::<OrderReply>(bytes, max);

@@ -239,6 +239,29 @@ pub fn encode_message<T: Encode>(message: &T) -> Result<Vec<u8>, WireError> {
     bincode::encode_to_vec(message, config()).map_err(|e| WireError::Malformed(e.to_string()))
 }
 
+/// Encodes the first message of a share (the assignment) after the wire version, so a host built from another
+/// source can say so instead of misreading it or every batch after it.
+pub fn encode_versioned<T: Encode>(message: &T) -> Result<Vec<u8>, WireError> {
+    encode_message(&(WIRE_VERSION, message))
+}
+
+/// Decodes a message encoded by [`encode_versioned`]: [`WireError::Version`] when it is of another wire version,
+/// whatever follows.
+pub fn decode_versioned<T: Decode<()>>(bytes: &[u8], max_payload: usize) -> Result<T, WireError> {
+    match first_u32(bytes) {
+        Some(WIRE_VERSION) => {
+            decode_message::<(u32, T)>(bytes, max_payload).map(|(_, message)| message)
+        }
+        Some(found) => Err(WireError::Version {
+            found,
+            expected: WIRE_VERSION,
+        }),
+        None => Err(WireError::Malformed(
+            "the message does not start with a wire version".into(),
+        )),
+    }
+}
+
 /// Decodes a control message encoded by [`encode_message`], rejecting oversized and trailing bytes.
 pub fn decode_message<T: Decode<()>>(bytes: &[u8], max_payload: usize) -> Result<T, WireError> {
     if bytes.len() > max_payload {
@@ -278,6 +301,30 @@ mod tests {
         let header = Header::new(Kind::Frames, 77, 1, 3, tick);
         encode_batch(&mut buf, &header, robots, frames(robots, tick)).expect("encodes");
         buf
+    }
+
+    #[test]
+    fn a_versioned_message_of_another_build_is_refused_by_its_version() {
+        let bytes = encode_versioned(&(7u64, String::from("share"))).expect("encodes");
+        assert_eq!(
+            decode_versioned::<(u64, String)>(&bytes, DEFAULT_MAX_PAYLOAD),
+            Ok((7, "share".into()))
+        );
+        let older =
+            encode_message(&(WIRE_VERSION - 1, 7u64, String::from("share"))).expect("encodes");
+        assert_eq!(
+            decode_versioned::<(u64, String)>(&older, DEFAULT_MAX_PAYLOAD),
+            Err(WireError::Version {
+                found: WIRE_VERSION - 1,
+                expected: WIRE_VERSION
+            })
+        );
+        // A build that sent the message without a version: its first field is read as one, and refused.
+        let unversioned = encode_message(&(7u64, String::from("share"))).expect("encodes");
+        assert!(matches!(
+            decode_versioned::<(u64, String)>(&unversioned, DEFAULT_MAX_PAYLOAD),
+            Err(WireError::Version { found: 7, .. })
+        ));
     }
 
     #[test]

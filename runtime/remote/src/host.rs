@@ -28,7 +28,7 @@ use zenoh::query::{Query, Queryable};
 use zenoh::sample::SampleKind;
 
 use super::auth::{Seal, answer_channel};
-use super::codec::{self, Header, Kind};
+use super::codec::{self, Header, Kind, WireError};
 use super::host_to_world::{AssignmentReply, OrderReply, Reply};
 use super::session::{ZenohOptions, zenoh_error};
 use super::world_to_host::{Assignment, FrameEntry, Order, OrderAction, parse_kill};
@@ -296,8 +296,14 @@ fn authentic_assignment(
         .seal
         .open(&keys::assign(&options.name), &bytes)
         .map_err(|e| Refusal::Silent(e.to_string()))?;
-    let assignment = codec::decode_message::<Assignment>(payload, options.max_payload)
-        .map_err(|e| Refusal::Answered(format!("malformed assignment: {e}")))?;
+    let assignment = codec::decode_versioned::<Assignment>(payload, options.max_payload).map_err(
+        |e| match e {
+            WireError::Version { .. } => Refusal::Answered(format!(
+                "{e}: build the world's machine and the hosts from the same source"
+            )),
+            e => Refusal::Answered(format!("malformed assignment: {e}")),
+        },
+    )?;
     if assignment.name != options.name {
         return Err(Refusal::Answered(format!(
             "the assignment is for host '{}', this is '{}'",

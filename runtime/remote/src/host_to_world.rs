@@ -55,7 +55,7 @@ pub enum AssignmentReply {
     },
     /// The host cannot run the share, and why.
     Refused {
-        /// Epoch of the assignment this answers.
+        /// Epoch of the assignment this answers; 0 when the host could not read it (another build's assignment).
         epoch: u32,
         /// What went wrong, for the user.
         reason: String,

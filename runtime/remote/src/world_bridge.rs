@@ -670,7 +670,7 @@ impl RemoteHosts {
             },
         };
         let key = keys::assign(&host.share.name);
-        let mut payload = codec::encode_message(&assignment)?;
+        let mut payload = codec::encode_versioned(&assignment)?;
         host.seal.seal(&key, &mut payload);
         tracing::info!(
             host = host.share.name,
@@ -782,7 +782,8 @@ impl RemoteHosts {
                 self.dropped.stale += 1;
                 Ok(())
             }
-            Ok(AssignmentReply::Refused { epoch, reason }) if epoch == host.epoch => {
+            // Epoch 0: the host could not read the assignment, so it cannot read this one either.
+            Ok(AssignmentReply::Refused { epoch, reason }) if epoch == host.epoch || epoch == 0 => {
                 host.state = State::Absent;
                 if before_run {
                     Err(RemoteError::Refused {
@@ -1087,6 +1088,8 @@ mod tests {
         /// Answers honestly, and also sends replies on another host's key for that host's robot, tagged with its
         /// own key (one host speaking for another).
         Forger { victim: &'static str, robot: u32 },
+        /// Built from another source: refuses every assignment as unreadable (epoch 0).
+        OtherBuild,
     }
 
     /// The test's key of host `name` (made of its name, so every test agrees).
@@ -1134,8 +1137,26 @@ mod tests {
                     let payload = assign_seal
                         .open(&keys::assign(&name), &bytes)
                         .expect("the world's key");
+                    let reply = |answer: &AssignmentReply| {
+                        let mut reply = codec::encode_message(answer).expect("encodes");
+                        assign_seal.seal(
+                            &answer_channel(query.key_expr().as_str(), &bytes),
+                            &mut reply,
+                        );
+                        query
+                            .reply(query.key_expr().clone(), reply)
+                            .wait()
+                            .expect("reply");
+                    };
+                    if let Behaviour::OtherBuild = behaviour {
+                        reply(&AssignmentReply::Refused {
+                            epoch: 0,
+                            reason: "wire version 1, this build speaks version 2".into(),
+                        });
+                        continue;
+                    }
                     let assignment: Assignment =
-                        codec::decode_message(payload, codec::DEFAULT_MAX_PAYLOAD)
+                        codec::decode_versioned(payload, codec::DEFAULT_MAX_PAYLOAD)
                             .expect("an assignment");
                     // Like a real host: ready to receive frames before saying so.
                     let frames = declaring
@@ -1157,18 +1178,9 @@ mod tests {
                     };
                     let robots: Vec<u32> = assignment.robots.iter().map(|(r, _)| *r).collect();
                     let _ = share_tx.send((robots, frames, publisher, forged));
-                    let mut reply = codec::encode_message(&AssignmentReply::Ready {
+                    reply(&AssignmentReply::Ready {
                         epoch: assignment.epoch,
-                    })
-                    .expect("encodes");
-                    assign_seal.seal(
-                        &answer_channel(query.key_expr().as_str(), &bytes),
-                        &mut reply,
-                    );
-                    query
-                        .reply(query.key_expr().clone(), reply)
-                        .wait()
-                        .expect("reply");
+                    });
                 }
             });
             let token = session
@@ -1303,6 +1315,19 @@ mod tests {
             .map(|a| a.port())
             .expect("a free port");
         format!("tcp/127.0.0.1:{port}")
+    }
+
+    #[test]
+    fn a_host_that_cannot_read_its_assignment_fails_the_run_before_it_starts() {
+        let endpoint = endpoint();
+        let mut world = world(&endpoint, &[("old", &[0, 1])]);
+        let _old = FakeHost::start(&endpoint, "old", Behaviour::OtherBuild);
+        let joined = world.wait_for_hosts(Duration::from_secs(30));
+        assert!(
+            matches!(&joined, Err(RemoteError::Refused { host, reason })
+                if host == "old" && reason.contains("wire version")),
+            "{joined:?}"
+        );
     }
 
     #[test]
