@@ -8,8 +8,8 @@
 //! entries, and decoding starts from the empty message ([`SensorFrame::empty`], [`ActuatorCommand::idle`],
 //! [`SupervisorSnapshot::default`]), so every value comes back bit for bit, whatever the length fields say.
 //!
-//! Every field is named in a destructuring pattern on both sides, so a field added to a message fails to compile
-//! here until it is encoded.
+//! Both sides follow the struct's field order. `encode` names every field in a destructuring pattern and `decode`
+//! in a struct expression, so a field added to a message fails to compile here until it is encoded.
 
 use std::sync::LazyLock;
 
@@ -98,22 +98,21 @@ fn encode_prefix<T: Encode + SameBits, E: Encoder>(
         .try_for_each(|item| item.encode(encoder))
 }
 
-/// Reads what [`encode_prefix`] wrote into the leading entries of `items`; the others keep their empty values.
-fn decode_prefix<T: Decode<C>, C, D: Decoder<Context = C>>(
+/// Reads what [`encode_prefix`] wrote into the leading entries of `items`, whose others keep their empty values.
+fn decode_prefix<T: Decode<C>, const N: usize, C, D: Decoder<Context = C>>(
     decoder: &mut D,
-    items: &mut [T],
-) -> Result<(), DecodeError> {
+    mut items: [T; N],
+) -> Result<[T; N], DecodeError> {
     let kept = u32::decode(decoder)? as usize;
-    if kept > items.len() {
+    if kept > N {
         return Err(DecodeError::OtherString(format!(
-            "{kept} entries for an array of {}",
-            items.len()
+            "{kept} entries for an array of {N}"
         )));
     }
-    items[..kept].iter_mut().try_for_each(|item| {
+    for item in &mut items[..kept] {
         *item = T::decode(decoder)?;
-        Ok(())
-    })
+    }
+    Ok(items)
 }
 
 impl Encode for SensorFrame {
@@ -161,45 +160,34 @@ impl Encode for SensorFrame {
 
 impl<Context> Decode<Context> for SensorFrame {
     fn decode<D: Decoder<Context = Context>>(decoder: &mut D) -> Result<Self, DecodeError> {
-        let mut frame = *EMPTY_FRAME;
-        let SensorFrame {
-            tick,
-            robot,
-            held_object,
-            alive,
-            gripper_holding,
-            proximity_len,
-            light_len,
-            ground_len,
-            ranges_len,
-            camera_len,
-            rab_len,
-            inbox_len,
-            proximity,
-            light,
-            ground,
-            ranges,
-            scan_start,
-            scan_span,
-            camera,
-            rab,
-            pheromone,
-            pheromone_gradient,
-            position,
-            heading,
-        } = &mut frame;
-        (*tick, *robot, *held_object, *alive, *gripper_holding) = Decode::decode(decoder)?;
-        (*proximity_len, *light_len, *ground_len, *ranges_len) = Decode::decode(decoder)?;
-        (*camera_len, *rab_len, *inbox_len) = Decode::decode(decoder)?;
-        decode_prefix(decoder, proximity)?;
-        decode_prefix(decoder, light)?;
-        decode_prefix(decoder, ground)?;
-        decode_prefix(decoder, ranges)?;
-        (*scan_start, *scan_span) = Decode::decode(decoder)?;
-        decode_prefix(decoder, camera)?;
-        decode_prefix(decoder, rab)?;
-        (*pheromone, *pheromone_gradient, *position, *heading) = Decode::decode(decoder)?;
-        Ok(frame)
+        let empty = &*EMPTY_FRAME;
+        // A struct expression evaluates its fields in the order written: the order `encode` wrote them.
+        Ok(SensorFrame {
+            tick: Decode::decode(decoder)?,
+            robot: Decode::decode(decoder)?,
+            held_object: Decode::decode(decoder)?,
+            alive: Decode::decode(decoder)?,
+            gripper_holding: Decode::decode(decoder)?,
+            proximity_len: Decode::decode(decoder)?,
+            light_len: Decode::decode(decoder)?,
+            ground_len: Decode::decode(decoder)?,
+            ranges_len: Decode::decode(decoder)?,
+            camera_len: Decode::decode(decoder)?,
+            rab_len: Decode::decode(decoder)?,
+            inbox_len: Decode::decode(decoder)?,
+            proximity: decode_prefix(decoder, empty.proximity)?,
+            light: decode_prefix(decoder, empty.light)?,
+            ground: decode_prefix(decoder, empty.ground)?,
+            ranges: decode_prefix(decoder, empty.ranges)?,
+            scan_start: Decode::decode(decoder)?,
+            scan_span: Decode::decode(decoder)?,
+            camera: decode_prefix(decoder, empty.camera)?,
+            rab: decode_prefix(decoder, empty.rab)?,
+            pheromone: Decode::decode(decoder)?,
+            pheromone_gradient: Decode::decode(decoder)?,
+            position: Decode::decode(decoder)?,
+            heading: Decode::decode(decoder)?,
+        })
     }
 }
 
@@ -213,28 +201,24 @@ impl Encode for SupervisorSnapshot {
             fired,
         } = self;
         let empty = &IDLE_COMMAND.supervisors;
-        (count, fired_len).encode(encoder)?;
+        count.encode(encoder)?;
         encode_prefix(states, &empty.states, encoder)?;
         encode_prefix(entered, &empty.entered, encoder)?;
+        fired_len.encode(encoder)?;
         encode_prefix(fired, &empty.fired, encoder)
     }
 }
 
 impl<Context> Decode<Context> for SupervisorSnapshot {
     fn decode<D: Decoder<Context = Context>>(decoder: &mut D) -> Result<Self, DecodeError> {
-        let mut snapshot = IDLE_COMMAND.supervisors;
-        let SupervisorSnapshot {
-            count,
-            states,
-            entered,
-            fired_len,
-            fired,
-        } = &mut snapshot;
-        (*count, *fired_len) = Decode::decode(decoder)?;
-        decode_prefix(decoder, states)?;
-        decode_prefix(decoder, entered)?;
-        decode_prefix(decoder, fired)?;
-        Ok(snapshot)
+        let empty = &IDLE_COMMAND.supervisors;
+        Ok(SupervisorSnapshot {
+            count: Decode::decode(decoder)?,
+            states: decode_prefix(decoder, empty.states)?,
+            entered: decode_prefix(decoder, empty.entered)?,
+            fired_len: Decode::decode(decoder)?,
+            fired: decode_prefix(decoder, empty.fired)?,
+        })
     }
 }
 
@@ -272,35 +256,27 @@ impl Encode for ActuatorCommand {
 
 impl<Context> Decode<Context> for ActuatorCommand {
     fn decode<D: Decoder<Context = Context>>(decoder: &mut D) -> Result<Self, DecodeError> {
-        let mut command = *IDLE_COMMAND;
-        let ActuatorCommand {
-            tick,
-            robot,
-            drive,
-            wheels,
-            twist,
-            led,
-            beacon,
-            rab_len,
-            rab_payload,
-            outbox_len,
-            gripper,
-            turret_mode,
-            turret,
-            scanner,
-            scanner_setting,
-            pheromone_deposit,
-            events_len,
-            events,
-            supervisors,
-        } = &mut command;
-        (*tick, *robot, *drive, *wheels, *twist, *led, *beacon) = Decode::decode(decoder)?;
-        (*rab_len, *rab_payload, *outbox_len, *gripper) = Decode::decode(decoder)?;
-        (*turret_mode, *turret, *scanner, *scanner_setting) = Decode::decode(decoder)?;
-        (*pheromone_deposit, *events_len) = Decode::decode(decoder)?;
-        decode_prefix(decoder, events)?;
-        *supervisors = Decode::decode(decoder)?;
-        Ok(command)
+        Ok(ActuatorCommand {
+            tick: Decode::decode(decoder)?,
+            robot: Decode::decode(decoder)?,
+            drive: Decode::decode(decoder)?,
+            wheels: Decode::decode(decoder)?,
+            twist: Decode::decode(decoder)?,
+            led: Decode::decode(decoder)?,
+            beacon: Decode::decode(decoder)?,
+            rab_len: Decode::decode(decoder)?,
+            rab_payload: Decode::decode(decoder)?,
+            outbox_len: Decode::decode(decoder)?,
+            gripper: Decode::decode(decoder)?,
+            turret_mode: Decode::decode(decoder)?,
+            turret: Decode::decode(decoder)?,
+            scanner: Decode::decode(decoder)?,
+            scanner_setting: Decode::decode(decoder)?,
+            pheromone_deposit: Decode::decode(decoder)?,
+            events_len: Decode::decode(decoder)?,
+            events: decode_prefix(decoder, IDLE_COMMAND.events)?,
+            supervisors: Decode::decode(decoder)?,
+        })
     }
 }
 
