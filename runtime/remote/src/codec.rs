@@ -22,7 +22,7 @@ const WIRE_REVISION: u32 = 2;
 /// Version of the wire format: the message layout version and the encoding's revision, so hosts built from
 /// different message layouts or encodings reject each other's payloads instead of misreading them.
 pub const WIRE_VERSION: u32 = MESSAGE_VERSION << 8 | WIRE_REVISION;
-/// Default largest payload accepted (bytes): far above 1,000 robots' frames (at most about 0.8 kB each).
+/// Default largest payload accepted (bytes): far above 1,000 robots' frames (at most about 1 kB each).
 pub const DEFAULT_MAX_PAYLOAD: usize = 16 << 20;
 
 /// The bincode configuration of every cross-host message.
