@@ -381,6 +381,35 @@ fn replacement_agent_joins_after_a_death_notice_and_answers_again() {
     expect_echo(&world, 1, 4);
 }
 
+#[test]
+fn a_death_notice_read_after_the_replacement_joined_leaves_the_robot_to_it() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(2, 300)).expect("create world");
+    world.start_without_agents();
+    // Robot 1's first agent (never started here) is killed at start-up; its replacement joins before the world
+    // reads the launcher's death notice.
+    for robot in 0..2 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    let notices = world.death_notices();
+    let replacement = run.children[1].id();
+    let took = notices
+        .mark_agent_dead(1, replacement + 1)
+        .expect("robot 1 is in the run");
+    assert!(!took, "a notice for another agent took effect");
+    assert!(world.agent_present(1), "the late notice took the robot");
+    let outcome = world.tick_with(sense).expect("tick 1");
+    assert_eq!(outcome.answered, 2, "{outcome:?}");
+    // A notice for the agent that owns the robot takes effect.
+    assert!(
+        notices
+            .mark_agent_dead(1, replacement)
+            .expect("robot 1 is in the run")
+    );
+    assert!(!world.agent_present(1));
+}
+
 /// Names the run a [`world_process_for_the_world_death_test`] process is the world of.
 const WORLD_RUN_ENV: &str = "SWARM_TEST_WORLD_RUN";
 /// The iceoryx2 root directory of that run.

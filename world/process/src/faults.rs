@@ -119,11 +119,16 @@ pub fn follow_launcher(notices: Option<DeathNotices>) -> Receiver<WorldCommand> 
                 tracing::warn!("ignoring the launcher line '{line}'");
                 continue;
             };
-            if let (WorldCommand::Dead(robot), Some(notices)) = (command, &notices)
-                && let Err(e) = notices.mark_dead(robot)
-            {
-                tracing::warn!("ignoring death notice '{line}': {e}");
-                continue;
+            if let (WorldCommand::Dead { robot, agent }, Some(notices)) = (command, &notices) {
+                match notices.mark_agent_dead(robot, agent) {
+                    Ok(true) => {}
+                    // The main loop still hears of the death: the robot is down until its replacement rejoins.
+                    Ok(false) => tracing::debug!(robot, agent, "the replacement joined first"),
+                    Err(e) => {
+                        tracing::warn!("ignoring death notice '{line}': {e}");
+                        continue;
+                    }
+                }
             }
             if sender.send(command).is_err() {
                 break;
@@ -581,7 +586,7 @@ impl FaultDriver {
 
     fn take(&mut self, command: WorldCommand) {
         match command {
-            WorldCommand::Dead(robot) if (robot as usize) < self.robots.len() => {
+            WorldCommand::Dead { robot, .. } if (robot as usize) < self.robots.len() => {
                 self.notices.push(robot);
             }
             WorldCommand::Rejoin { robot, tick } if (robot as usize) < self.robots.len() => {

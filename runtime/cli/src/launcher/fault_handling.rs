@@ -42,8 +42,9 @@ impl Supervision {
         }
         for action in startup {
             if let (FaultKind::Kill, Some(robot)) = (action.kind, action.robot) {
+                let agent = self.robots[robot as usize].pid;
                 self.kill_and_reap(robot);
-                self.send_world(WorldCommand::Dead(robot));
+                self.send_world(WorldCommand::Dead { robot, agent });
                 let index = self.log_fault("kill", Some(robot), Some(0));
                 self.faults[index].detection_tick = Some(0);
                 self.faults[index].status = Some("killed at start-up".into());

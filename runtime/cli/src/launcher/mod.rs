@@ -872,7 +872,8 @@ impl Supervision {
             } else {
                 tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
             }
-            self.send_world(WorldCommand::Dead(robot));
+            let agent = self.robots[robot as usize].pid;
+            self.send_world(WorldCommand::Dead { robot, agent });
             self.deaths.push(Death {
                 robot,
                 after_tick: self.last_tick,

@@ -159,8 +159,14 @@ impl fmt::Display for SpawnPose {
 /// One line from the launcher to the world.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum WorldCommand {
-    /// Robot's agent is gone (death notice).
-    Dead(u32),
+    /// A robot's agent is gone (death notice).
+    Dead {
+        /// The robot.
+        robot: u32,
+        /// The agent's process id, 0 when the launcher knows none. A notice that arrives after the robot's
+        /// replacement agent has joined must not take the robot from the replacement.
+        agent: u32,
+    },
     /// Robot's replacement agent takes part from this tick on.
     Rejoin {
         /// The robot.
@@ -189,7 +195,7 @@ pub enum WorldCommand {
 impl fmt::Display for WorldCommand {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            WorldCommand::Dead(robot) => write!(f, "dead {robot}"),
+            WorldCommand::Dead { robot, agent } => write!(f, "dead {robot} {agent}"),
             WorldCommand::Rejoin { robot, tick } => write!(f, "rejoin {robot} {tick}"),
             WorldCommand::Applied(tick) => write!(f, "applied {tick}"),
             WorldCommand::KillHost(host) => write!(f, "kill-host {host}"),
@@ -209,7 +215,10 @@ impl WorldCommand {
     pub fn parse(line: &str) -> Option<WorldCommand> {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
-            ["dead", robot] => Some(WorldCommand::Dead(robot.parse().ok()?)),
+            ["dead", robot, agent] => Some(WorldCommand::Dead {
+                robot: robot.parse().ok()?,
+                agent: agent.parse().ok()?,
+            }),
             ["rejoin", robot, tick] => Some(WorldCommand::Rejoin {
                 robot: robot.parse().ok()?,
                 tick: tick.parse().ok()?,
@@ -261,7 +270,10 @@ mod tests {
     #[test]
     fn every_command_parses_back_from_its_line() {
         for command in [
-            WorldCommand::Dead(3),
+            WorldCommand::Dead {
+                robot: 3,
+                agent: 4242,
+            },
             WorldCommand::Rejoin { robot: 3, tick: 58 },
             WorldCommand::Applied(50),
             WorldCommand::KillHost(1),

@@ -140,6 +140,16 @@ impl DeathNotices {
         self.notices.fetch_add(1, Ordering::Release);
         Ok(())
     }
+
+    /// The agent with process id `agent` (0: whichever) of `robot` is dead: as [`DeathNotices::mark_dead`],
+    /// unless another agent has claimed the robot since, which keeps it (a notice read after the robot's
+    /// replacement joined). Returns whether the notice took effect.
+    pub fn mark_agent_dead(&self, robot: u32, agent: u32) -> Result<bool, TransportError> {
+        if robot < self.sync.capacity() && self.sync.claimed_by_another(robot, agent) {
+            return Ok(false);
+        }
+        self.mark_dead(robot).map(|()| true)
+    }
 }
 
 /// The world's reading end of one robot's command board. Fields drop in declaration order: entry, port, service.
