@@ -764,3 +764,22 @@ fn an_agent_killed_on_a_host_is_restarted_there_by_its_policy() {
     }
     hosts.stop_and_check_clean();
 }
+
+/// A `ZENOH_RUNTIME` zenoh cannot parse (zenoh itself would panic on it) is an error that names it, and nothing
+/// starts.
+#[test]
+fn a_malformed_zenoh_runtime_layout_is_an_error_not_a_panic() {
+    let output = Command::new(bin_dir().join("swarm"))
+        .args(["host", "--connect", "tcp/127.0.0.1:1", "--insecure"])
+        .env("ZENOH_RUNTIME", "(app: (worker_threads: many))")
+        .output()
+        .expect("swarm starts");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("ZENOH_RUNTIME=(app: (worker_threads: many))")
+            && stderr.contains("not a zenoh runtime layout"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -29,7 +29,8 @@ pub const ZENOH_RUNTIME_ENV: &str = "ZENOH_RUNTIME";
 const ONE_RUNTIME: &str =
     "(rx: (handover: app), tx: (handover: app), acc: (handover: app), net: (handover: app))";
 
-/// Makes zenoh run all its work on one thread unless `ZENOH_RUNTIME` already says otherwise.
+/// Makes zenoh run all its work on one thread unless `ZENOH_RUNTIME` already says otherwise, and checks a layout
+/// the user set there: zenoh would panic on one it cannot parse.
 ///
 /// By default zenoh spreads its work over five runtimes with six threads. A batch then crossed two threads on its
 /// way in (the thread watching the socket handed it to a receiving worker, which also woke the second receiving
@@ -39,12 +40,42 @@ const ONE_RUNTIME: &str =
 ///
 /// # Safety
 ///
-/// It sets an environment variable: call it before the process starts its second thread.
-pub unsafe fn run_zenoh_on_one_thread() {
-    if std::env::var_os(ZENOH_RUNTIME_ENV).is_none() {
+/// It sets an environment variable and the panic hook for a moment: call it before the process starts its
+/// second thread.
+pub unsafe fn configure_zenoh_runtime() -> Result<(), RemoteError> {
+    let Some(layout) = std::env::var_os(ZENOH_RUNTIME_ENV) else {
         // SAFETY: the caller guarantees that no other thread runs yet.
         unsafe { std::env::set_var(ZENOH_RUNTIME_ENV, ONE_RUNTIME) };
+        return Ok(());
+    };
+    let invalid = |detail: String| RemoteError::Zenoh {
+        action: format!("reading {ZENOH_RUNTIME_ENV}={}", layout.to_string_lossy()),
+        detail,
+    };
+    if layout.to_str().is_none() {
+        return Err(invalid("not UTF-8".into()));
     }
+    // zenoh parses the variable once, in a lazily initialised static that unwraps the result: parse it now, with
+    // the panic caught and kept quiet, and say what is wrong instead.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let parsed = std::panic::catch_unwind(|| {
+        let _ = &*zenoh_runtime::ZRUNTIME_PARAM;
+    });
+    std::panic::set_hook(hook);
+    parsed.map_err(|panic| {
+        let message = panic
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| panic.downcast_ref::<&str>().map(|s| (*s).to_owned()))
+            .unwrap_or_default();
+        let detail = message
+            .trim_start_matches("called `Result::unwrap()` on an `Err` value: ")
+            .to_owned();
+        invalid(format!(
+            "not a zenoh runtime layout ({detail}); e.g. {ONE_RUNTIME}"
+        ))
+    })
 }
 
 /// What every zenoh session of a multi-host run is configured with.

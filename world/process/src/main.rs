@@ -56,7 +56,10 @@ struct Cli {
 
 fn main() -> ExitCode {
     // SAFETY: the process has one thread here.
-    unsafe { swarm_remote::session::run_zenoh_on_one_thread() };
+    if let Err(e) = unsafe { swarm_remote::session::configure_zenoh_runtime() } {
+        eprintln!("swarm-world: error: {e}");
+        return ExitCode::FAILURE;
+    }
     swarm_contract::logging::init("info");
     let cli = Cli::parse();
     match run(&cli.args, &cli.hosts) {

@@ -338,7 +338,10 @@ const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
     // SAFETY: the process has one thread here.
-    unsafe { swarm_remote::session::run_zenoh_on_one_thread() };
+    if let Err(e) = unsafe { swarm_remote::session::configure_zenoh_runtime() } {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     swarm_contract::logging::init("info");
     match run(Cli::parse()) {
         Ok(code) => code,
