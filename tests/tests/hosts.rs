@@ -117,16 +117,25 @@ fn read(out: &Path, name: &str) -> Vec<u8> {
     swarm_system_tests::run_file(out, name)
 }
 
-/// Runs `config` with the arguments `common` once on this machine and once on two hosts, both to success and the
-/// second with nothing left behind; returns both run folders (single host first) and the hosts, still running.
+/// A tick deadline far above any tick of these runs on a loaded machine: a run is a pure function of (config,
+/// seed, schedule) only while no command misses its tick's deadline, and the suite's other tests share the CPUs.
+const COMPARED_TICK_DEADLINE_MS: &str = "10000";
+
+/// Runs `config` with the arguments `common` once on this machine and once on two hosts, both to success, with no
+/// command missing its tick and the second with nothing left behind; returns both run folders (single host first)
+/// and the hosts, still running.
 fn run_single_and_on_two_hosts(
     config: &str,
     common: &[&str],
 ) -> (tempfile::TempDir, tempfile::TempDir, Hosts) {
+    let common: Vec<&str> = ["--tick-deadline-ms", COMPARED_TICK_DEADLINE_MS]
+        .into_iter()
+        .chain(common.iter().copied())
+        .collect();
     let single = tempfile::tempdir().expect("a temporary directory");
     let out = single.path().display().to_string();
     let mut args = vec!["run", config, "--out", &out, "--no-progress"];
-    args.extend(common);
+    args.extend(&common);
     let outcome = swarm(&args);
     assert!(
         outcome.output.status.success(),
@@ -139,7 +148,7 @@ fn run_single_and_on_two_hosts(
     let out = multi.path().display().to_string();
     let host_args = hosts.run_args();
     let mut args = vec!["run", config, "--out", &out, "--no-progress"];
-    args.extend(common);
+    args.extend(&common);
     args.extend(host_args.iter().map(String::as_str));
     let outcome = swarm(&args);
     assert!(
@@ -155,6 +164,14 @@ fn run_single_and_on_two_hosts(
             "host {} kept its share after the run ended:\n{}",
             daemon.name,
             daemon.log()
+        );
+    }
+    for run in [&single, &multi] {
+        assert_eq!(
+            summary(run.path())["commands_missing"],
+            0,
+            "a command missed its tick in {}: the runs cannot be compared",
+            run.path().display()
         );
     }
     (single, multi, hosts)
