@@ -551,14 +551,6 @@ impl SyncBlock {
         slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
     }
 
-    /// Whether an agent other than the one with process id `agent` (0: any) has claimed `robot`.
-    pub(crate) fn claimed_by_another(&self, robot: u32, agent: u32) -> bool {
-        let slot = self.slot(robot);
-        agent != 0
-            && slot.owner.load(Ordering::Acquire) == 1
-            && slot.owner_pid.load(Ordering::Acquire) != agent
-    }
-
     /// The process id of `robot`'s agent, if one owns the robot.
     pub(crate) fn agent_pid(&self, robot: u32) -> Option<u32> {
         let slot = self.slot(robot);

@@ -132,23 +132,28 @@ impl DeathNotices {
     /// `robot` is dead: the current tick stops waiting for it at once and later ticks do not wait for it until
     /// a replacement agent joins.
     pub fn mark_dead(&self, robot: u32) -> Result<(), TransportError> {
-        let capacity = self.sync.capacity();
-        if robot >= capacity {
-            return Err(TransportError::RobotOutOfRange { robot, capacity });
-        }
-        self.sync.mark_dead(robot);
-        self.notices.fetch_add(1, Ordering::Release);
-        Ok(())
+        self.mark_agent_dead(robot, 0).map(drop)
     }
 
     /// The agent with process id `agent` (0: whichever) of `robot` is dead: as [`DeathNotices::mark_dead`],
     /// unless another agent has claimed the robot since, which keeps it (a notice read after the robot's
     /// replacement joined). Returns whether the notice took effect.
     pub fn mark_agent_dead(&self, robot: u32, agent: u32) -> Result<bool, TransportError> {
-        if robot < self.sync.capacity() && self.sync.claimed_by_another(robot, agent) {
+        let capacity = self.sync.capacity();
+        if robot >= capacity {
+            return Err(TransportError::RobotOutOfRange { robot, capacity });
+        }
+        if agent != 0
+            && self
+                .sync
+                .agent_pid(robot)
+                .is_some_and(|owner| owner != agent)
+        {
             return Ok(false);
         }
-        self.mark_dead(robot).map(|()| true)
+        self.sync.mark_dead(robot);
+        self.notices.fetch_add(1, Ordering::Release);
+        Ok(true)
     }
 }
 
