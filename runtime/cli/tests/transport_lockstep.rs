@@ -382,6 +382,39 @@ fn replacement_agent_joins_after_a_death_notice_and_answers_again() {
 }
 
 #[test]
+fn an_agent_continued_after_its_robot_was_replaced_is_not_counted() {
+    let mut run = Run::new();
+    let mut world = WorldLink::create(&run.spec, config(2, 300)).expect("create world");
+    for robot in 0..2 {
+        run.spawn(robot, &[]);
+    }
+    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
+    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 2);
+    // Robot 1's agent is stopped and reported, as the fault driver does for a frozen robot.
+    let stopped = libc::pid_t::try_from(run.children[1].id()).expect("a pid");
+    // SAFETY: kill(2) with a valid signal on our own child.
+    assert_eq!(unsafe { libc::kill(stopped, libc::SIGSTOP) }, 0);
+    world.mark_dead(1).expect("death notice");
+    assert_eq!(world.tick_with(sense).expect("tick 2").dead, 1);
+    // A replacement that joins and never answers: any answer for robot 1 now comes from the stopped agent.
+    run.spawn(1, &["--freeze-at", "0"]);
+    world
+        .wait_for_agents(JOIN_TIMEOUT)
+        .expect("replacement joins");
+    // SAFETY: as above.
+    assert_eq!(unsafe { libc::kill(stopped, libc::SIGCONT) }, 0);
+    for tick in 3..=6 {
+        let outcome = world.tick_with(sense).expect("tick");
+        assert_eq!(
+            (outcome.answered, outcome.missing),
+            (1, 1),
+            "tick {tick}: {outcome:?}"
+        );
+        expect_echo(&world, 0, tick);
+    }
+}
+
+#[test]
 fn a_death_notice_read_after_the_replacement_joined_leaves_the_robot_to_it() {
     let mut run = Run::new();
     let mut world = WorldLink::create(&run.spec, config(2, 300)).expect("create world");

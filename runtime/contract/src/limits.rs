@@ -40,8 +40,8 @@ pub struct Limits {
     /// How long a replacement agent keeps trying to join while the world frees the ports of the agent it
     /// replaces, in milliseconds. Default 10,000.
     pub agent_join_retry_ms: u64,
-    /// How long a joining agent waits for the death notice of its robot's previous agent and for the world to
-    /// replace the robot's command board, in milliseconds. Default 30,000.
+    /// How long a joining agent waits for the death notice of its robot's previous agent, and for a previous
+    /// agent stopped in the middle of writing its command slot, in milliseconds. Default 30,000.
     pub agent_board_wait_ms: u64,
     /// Free space the run leaves on the disk of its run folder, in MiB: when less is free the run stops, with
     /// its records complete. Default 100.

@@ -698,7 +698,7 @@ impl Share {
             let Some(link) = self.link.as_mut() else {
                 return Err("the share is ending".into());
             };
-            // Serves the replacement's request for a fresh command board while waiting.
+            // Has the dead predecessor's iceoryx2 resources removed while waiting.
             let _ = link.wait_for_agents(REPLACEMENT_POLL);
             if link.agent_present(slot as u32) {
                 return Ok(());

@@ -1,9 +1,9 @@
 //! An agent's side of the lockstep: join a run for one robot, sleep on its chain's wake word until the chain
 //! starts an open tick (waking the rest of the chain if it is the first to run), load the robot's own frame
-//! from the frame board, and answer by writing the command board of its robot.
+//! from the frame board, and answer by writing its robot's command slot.
 //!
-//! It must never answer for another robot (its command board is its robot's alone, with a single writer) and
-//! never answer a tick the world has not opened yet, nor the same tick twice.
+//! It must never answer for another robot (it writes its robot's command slot only, and only while the robot is
+//! its own) and never answer a tick the world has not opened yet, nor the same tick twice.
 //!
 //! Every function an agent runs once per tick (here, in the sync block and futex modules, in the player and in
 //! `robot-agent`'s tick loop) is placed in the link section `swarm_hot`. With a thousand agent processes on two
@@ -16,12 +16,12 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
 use iceoryx2::port::reader::{EntryHandle, Reader, ReaderCreateError};
-use iceoryx2::port::writer::{EntryHandleMut, Writer, WriterCreateError};
 use iceoryx2::prelude::{ZeroCopySend, ipc};
 
 use super::TransportError;
+use super::command_slots::CommandSlots;
 use super::run::RunSpec;
-use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
+use super::services::{self, Board};
 use super::sync_block::{JoinClaim, SyncBlock};
 use super::world_watch::WorldEndNotice;
 use super::{placement, priority};
@@ -82,32 +82,37 @@ impl Tick<'_> {
     pub fn answer(self, command: &mut ActuatorCommand) {
         command.outbox_len = 0;
         let link = self.link;
-        let tick = link.frame.tick;
-        if let Some(ports) = link.mail.ports.as_ref().filter(|_| link.has_mail) {
+        let (robot, writer, tick) = (link.robot, link.pid, link.frame.tick);
+        let mut posted = None;
+        if link.has_mail && link.mail.ports.is_some() {
             let outbox = &link.mail.outbox;
             if !outbox.is_empty() {
-                let mut posted = *outbox;
-                posted.tick = tick;
-                posted.owner = link.robot;
-                ports.outbox.update_with_copy(posted);
+                let mut mailbox = *outbox;
+                mailbox.tick = tick;
+                mailbox.owner = robot;
                 command.outbox_len = outbox.messages().len() as u8;
+                posted = Some(mailbox);
             }
         }
         command.tick = tick;
-        command.robot = link.robot;
-        link.ports.command_entry.update_with_copy(*command);
-        link.sync.claim(link.robot, tick);
+        command.robot = robot;
+        let sync = &link.sync;
+        // An agent whose robot another agent has claimed since (it was frozen, then replaced) is not counted.
+        let owns = || sync.claimer(robot) == writer;
+        if link
+            .slots
+            .write(robot, writer, owns, command, posted.as_ref())
+        {
+            sync.claim(robot, tick);
+        }
     }
 }
 
-/// The iceoryx2 side of an agent: its node, its robot's entry of the frame board and its command board entry.
-/// Entry handles keep their ports and services alive; the fields are only held, in drop order.
+/// The iceoryx2 side of an agent: its node and its robot's entry of the frame board. The entry handle keeps its
+/// port and service alive; the other fields are only held, in drop order.
 struct Ports {
     frame_entry: EntryHandle<ipc::Service, u32, SensorFrame>,
-    command_entry: EntryHandleMut<ipc::Service, u32, ActuatorCommand>,
     _frame_reader: Reader<ipc::Service, u32>,
-    _command_writer: Writer<ipc::Service, u32>,
-    _command_board: Board,
     _frame_board: Board,
     _node: Node<ipc::Service>,
 }
@@ -121,11 +126,10 @@ struct Mail {
     ports: Option<MailPorts>,
 }
 
-/// An agent's mail ports (runs with mail only): its inbox entry and its command board's outbox entry. Fields drop
-/// in declaration order.
+/// An agent's inbox port (runs with mail only; its outbox is in its command slot). Fields drop in declaration
+/// order.
 struct MailPorts {
     inbox: EntryHandle<ipc::Service, u32, Mailbox>,
-    outbox: EntryHandleMut<ipc::Service, u32, Mailbox>,
     _inbox_reader: Reader<ipc::Service, u32>,
     _inbox_board: Board,
 }
@@ -169,6 +173,8 @@ pub enum WorldEnd {
 /// An agent's end of a run's local transport, for one robot.
 pub struct AgentLink {
     robot: u32,
+    /// This process's id: it writes the robot's command slot as that.
+    pid: u32,
     spin: u32,
     /// The last tick handed out by [`AgentLink::next_tick`] (0: none yet).
     last_tick: u64,
@@ -179,13 +185,14 @@ pub struct AgentLink {
     /// The robot's mailboxes (see [`Mail`]); their ports drop before the node in `ports`.
     mail: Box<Mail>,
     ports: Ports,
+    slots: CommandSlots,
     sync: Arc<SyncBlock>,
     /// Notices the end of the world process, so that waits need no timeout where it can.
     world_end: WorldEndNotice,
 }
 
 impl AgentLink {
-    /// Joins robot `robot` of `run` with the default board wait
+    /// Joins robot `robot` of `run` with the default wait for a predecessor
     /// ([`Limits::agent_board_wait_ms`](crate::limits::Limits)); see [`AgentLink::join_waiting`].
     pub fn join(run: &RunSpec, robot: u32) -> Result<AgentLink, TransportError> {
         AgentLink::join_waiting(
@@ -195,8 +202,9 @@ impl AgentLink {
         )
     }
 
-    /// Joins `run` as the agent of `robot`. Fails with a message naming the limit when the run has no place for
-    /// it, or when another live agent already runs this robot.
+    /// Joins `run` as the agent of `robot`, waiting up to `board_wait` for a dead predecessor's death notice.
+    /// Fails with a message naming the limit when the run has no place for it, or when another live agent
+    /// already runs this robot.
     pub fn join_waiting(
         run: &RunSpec,
         robot: u32,
@@ -231,8 +239,9 @@ impl AgentLink {
         if let JoinClaim::Taken = sync.claim_robot(robot, Instant::now() + board_wait) {
             return Err(TransportError::RobotTaken { robot });
         }
-        match Self::connect(run, robot, node, &sync, board_wait) {
-            Ok((ports, mail_ports)) => {
+        let pid = std::process::id();
+        match Self::connect(run, robot, node, &sync, pid, board_wait) {
+            Ok((ports, slots, mail_ports)) => {
                 let has_mail = mail_ports.is_some();
                 let mail = Box::new(Mail {
                     inbox: Mailbox::empty(robot),
@@ -266,10 +275,12 @@ impl AgentLink {
                 sync.announce_ready(robot);
                 Ok(AgentLink {
                     robot,
+                    pid,
                     spin: DEFAULT_AGENT_SPIN,
                     last_tick,
                     frame: SensorFrame::empty(robot),
                     ports,
+                    slots,
                     sync,
                     world_end,
                     has_mail,
@@ -288,19 +299,21 @@ impl AgentLink {
         robot: u32,
         node: Option<Node<ipc::Service>>,
         sync: &SyncBlock,
+        pid: u32,
         board_wait: Duration,
-    ) -> Result<(Ports, Option<MailPorts>), TransportError> {
-        if sync.needs_fresh_board(robot) {
-            sync.request_board(robot);
+    ) -> Result<(Ports, CommandSlots, Option<MailPorts>), TransportError> {
+        let slots = CommandSlots::open(&run.command_slots_path())?;
+        if slots.capacity() != sync.capacity() {
+            return Err(TransportError::InvalidRunFile {
+                path: run.command_slots_path(),
+                reason: format!(
+                    "slots for {} robots in a run of {}",
+                    slots.capacity(),
+                    sync.capacity()
+                ),
+            });
         }
-        let waited = Instant::now();
-        let generation =
-            sync.wait_board(robot, waited + board_wait)
-                .ok_or(TransportError::NoCommandBoard {
-                    robot,
-                    waited_ms: waited.elapsed().as_millis(),
-                })?;
-        sync.mark_used(robot);
+        slots.take_over(robot, pid, Instant::now() + board_wait)?;
         let node = match node {
             Some(node) => node,
             None => AgentNode::create(run, robot)?.node,
@@ -311,49 +324,24 @@ impl AgentLink {
             robot,
             sync.capacity(),
         )?;
-        let command_board = services::open_command_board(&node, robot, generation)?;
-        let command_writer = command_board
-            .writer_builder()
-            .create()
-            .map_err(|e| match e {
-                WriterCreateError::ExceedsMaxSupportedWriters => TransportError::ServiceFull {
-                    robot,
-                    service: services::command_service_name(robot, generation),
-                    limit: 1,
-                    what: "writers",
-                },
-                other => {
-                    TransportError::iceoryx(format!("writing robot {robot}'s commands"), other)
-                }
-            })?;
-        let command_entry = command_writer
-            .entry::<ActuatorCommand>(&COMMAND_KEY)
-            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
         let mail = if sync.placement().mail {
-            let outbox = command_writer
-                .entry::<Mailbox>(&OUTBOX_KEY)
-                .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s outbox entry"), e))?;
-            Some(Self::connect_inbox(&node, robot, sync.capacity(), outbox)?)
+            Some(Self::connect_inbox(&node, robot, sync.capacity())?)
         } else {
             None
         };
         let ports = Ports {
             frame_entry,
-            command_entry,
             _frame_reader: frame_reader,
-            _command_writer: command_writer,
-            _command_board: command_board,
             _frame_board: frame_board,
             _node: node,
         };
-        Ok((ports, mail))
+        Ok((ports, slots, mail))
     }
 
     fn connect_inbox(
         node: &Node<ipc::Service>,
         robot: u32,
         capacity: u32,
-        outbox: EntryHandleMut<ipc::Service, u32, Mailbox>,
     ) -> Result<MailPorts, TransportError> {
         let (board, reader, inbox) = Self::read_own_entry::<Mailbox>(
             node,
@@ -363,7 +351,6 @@ impl AgentLink {
         )?;
         Ok(MailPorts {
             inbox,
-            outbox,
             _inbox_reader: reader,
             _inbox_board: board,
         })

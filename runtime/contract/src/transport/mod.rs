@@ -3,9 +3,9 @@
 //! One tick: the world writes every robot's [`SensorFrame`](crate::messages::SensorFrame) into its entry of an
 //! iceoryx2 blackboard in shared memory, opens the tick and wakes one agent of each chain of robots, which wakes
 //! the rest of its chain. Each agent loads its own frame entry, writes its
-//! [`ActuatorCommand`](crate::messages::ActuatorCommand) into its robot's own command board and bumps one shared
+//! [`ActuatorCommand`](crate::messages::ActuatorCommand) into its robot's own command slot and bumps one shared
 //! acknowledgement counter; the last one wakes the world. The world waits on that one counter until every robot
-//! is accounted for or the tick's deadline passes, then reads each robot's command from its own board, so its
+//! is accounted for or the tick's deadline passes, then reads each robot's command from its own slot, so its
 //! view never depends on arrival order.
 //! docs/transport.md explains the choices.
 //!
@@ -13,11 +13,13 @@
 
 mod agent;
 mod cleaner;
+mod command_slots;
 pub mod futex;
 mod placement;
 pub mod priority;
 mod run;
 mod services;
+mod shared_map;
 mod sync_block;
 mod world;
 mod world_watch;
@@ -147,16 +149,32 @@ pub enum TransportError {
         /// How long the world waited.
         waited_ms: u128,
     },
-    /// The world did not provide a command board for a replacement agent in time.
+    /// A file of the run other than the sync block (the command slots) could not be created, opened or mapped.
+    #[error("lockstep file {path}: {source}")]
+    RunFile {
+        /// Path of the file.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// A file of the run exists but is not what this build expects.
+    #[error("lockstep file {path}: {reason}")]
+    InvalidRunFile {
+        /// Path of the file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The robot's command slot stayed taken by a live process, a predecessor stopped in the middle of a write.
     #[error(
-        "robot {robot} cannot join: the world has not replaced its command board after {waited_ms} ms \
-         (it does so at its next tick)"
+        "robot {robot} cannot join: its command slot is held by process {pid}, a previous agent of the robot \
+         stopped in the middle of writing a command (continue or kill it)"
     )]
-    NoCommandBoard {
+    CommandSlotHeld {
         /// The robot index.
         robot: u32,
-        /// How long the agent waited.
-        waited_ms: u128,
+        /// The process holding the slot.
+        pid: u32,
     },
     /// The world process no longer exists and never ended the run.
     #[error("the world process (pid {pid}) is gone without ending the run")]

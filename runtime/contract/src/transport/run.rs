@@ -87,6 +87,11 @@ impl RunSpec {
         Path::new(SHM_DIR).join(format!("{}lockstep", self.shm_prefix()))
     }
 
+    /// Path of the run's command slots (`command_slots`).
+    pub(crate) fn command_slots_path(&self) -> PathBuf {
+        Path::new(SHM_DIR).join(format!("{}commands", self.shm_prefix()))
+    }
+
     /// The iceoryx2 configuration of this run: its prefix and root, dead-node cleanup on creation off.
     pub(crate) fn iceoryx_config(&self) -> Result<Config, TransportError> {
         let mut config = Config::default();

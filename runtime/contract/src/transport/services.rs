@@ -1,11 +1,11 @@
 //! Names and limits of the iceoryx2 services of a run, in one place for the world (which creates them) and the
 //! agents (which only open them).
 //!
-//! Both services are iceoryx2 blackboards: fixed-size entries in shared memory that a writer updates in place and
-//! readers load lock-free. The frame board holds one entry per robot (the world writes, each agent reads its
-//! own); each robot has its own command board with one entry (its agent writes, the world reads), so no process
-//! can ever write another robot's command. A board's single writer slot stays taken when its writer dies, so
-//! after a death the world creates the next generation of that robot's command board for the replacement. docs/transport.md says why blackboards and not publish-subscribe.
+//! Both services are iceoryx2 blackboards: fixed-size entries in shared memory that one writer, the world, updates in
+//! place and readers load lock-free. The frame board holds one entry per robot, the inbox board (runs with mail
+//! only) one mailbox per robot; each agent reads its own. docs/transport.md says why blackboards and not
+//! publish-subscribe. The agents' answers go the other way through the command slots (`command_slots`): a
+//! blackboard admits one writer only.
 
 use iceoryx2::node::Node;
 use iceoryx2::prelude::{
@@ -17,17 +17,10 @@ use iceoryx2::service::port_factory::blackboard::PortFactory;
 use super::TransportError;
 use super::run::RunSpec;
 use crate::mail::Mailbox;
-use crate::messages::{ActuatorCommand, MESSAGE_VERSION, SensorFrame};
+use crate::messages::{MESSAGE_VERSION, SensorFrame};
 
-/// A blackboard of the run, keyed by robot index (frames) or by [`COMMAND_KEY`] (commands).
+/// A blackboard of the run, keyed by robot index.
 pub(crate) type Board = PortFactory<ipc::Service, u32>;
-
-/// The key of a command board's command.
-pub(crate) const COMMAND_KEY: u32 = 0;
-/// The key of a command board's outbox (in runs with mail only).
-pub(crate) const OUTBOX_KEY: u32 = 1;
-/// Nodes on a command board: the world and the robot's agent.
-const COMMAND_NODES: usize = 2;
 
 /// Name of the frame board.
 pub(crate) fn frame_service_name() -> String {
@@ -37,11 +30,6 @@ pub(crate) fn frame_service_name() -> String {
 /// Name of the inbox board (runs with mail only): one [`Mailbox`] per robot, keyed like the frame board.
 pub(crate) fn inbox_service_name() -> String {
     format!("swarm/v{MESSAGE_VERSION}/inboxes")
-}
-
-/// Name of generation `generation` of robot `robot`'s command board.
-pub(crate) fn command_service_name(robot: u32, generation: u32) -> String {
-    format!("swarm/v{MESSAGE_VERSION}/commands/{robot}/{generation}")
 }
 
 fn service_name(name: &str) -> Result<ServiceName, TransportError> {
@@ -105,63 +93,13 @@ fn create_per_robot_board<T: ZeroCopySend + Copy + 'static>(
 }
 
 /// Agent side: opens the board `name` that has one entry per robot (the frame board, the inbox board) of a run of
-/// `robots` robots, as robot `robot`'s agent.
+/// `robots` robots, as robot `robot`'s agent. A board whose places for nodes are all taken is
+/// [`TransportError::ServiceFull`] (the agent may retry once dead nodes are cleaned up).
 pub(crate) fn open_per_robot_board(
     node: &Node<ipc::Service>,
     name: &str,
     robot: u32,
     robots: u32,
-) -> Result<Board, TransportError> {
-    let nodes = robots as usize + 1 + SPARE_AGENT_PLACES;
-    open_board(node, robot, name, nodes)
-}
-
-/// World side: creates generation `generation` of robot `robot`'s command board (one writer, the robot's
-/// agent; one reader, the world), with an outbox entry when the run has `mail`.
-pub(crate) fn create_command_board(
-    node: &Node<ipc::Service>,
-    robot: u32,
-    generation: u32,
-    mail: bool,
-) -> Result<Board, TransportError> {
-    let name = command_service_name(robot, generation);
-    let creator = node
-        .service_builder(&service_name(&name)?)
-        .blackboard_creator::<u32>()
-        .max_readers(1)
-        .max_nodes(COMMAND_NODES)
-        .add::<ActuatorCommand>(COMMAND_KEY, ActuatorCommand::idle(robot, 0));
-    let creator = if mail {
-        creator.add::<Mailbox>(OUTBOX_KEY, Mailbox::empty(robot))
-    } else {
-        creator
-    };
-    creator
-        .create()
-        .map_err(|e| TransportError::iceoryx(format!("creating service {name}"), e))
-}
-
-/// Agent side: opens generation `generation` of robot `robot`'s command board.
-pub(crate) fn open_command_board(
-    node: &Node<ipc::Service>,
-    robot: u32,
-    generation: u32,
-) -> Result<Board, TransportError> {
-    open_board(
-        node,
-        robot,
-        &command_service_name(robot, generation),
-        COMMAND_NODES,
-    )
-}
-
-/// Opens the board `name` for robot `robot`'s agent; a board whose `nodes` places are taken is
-/// [`TransportError::ServiceFull`] (the agent may retry once dead nodes are cleaned up).
-fn open_board(
-    node: &Node<ipc::Service>,
-    robot: u32,
-    name: &str,
-    nodes: usize,
 ) -> Result<Board, TransportError> {
     node.service_builder(&service_name(name)?)
         .blackboard_opener::<u32>()
@@ -170,7 +108,7 @@ fn open_board(
             BlackboardOpenError::ExceedsMaxNumberOfNodes => TransportError::ServiceFull {
                 robot,
                 service: name.to_owned(),
-                limit: nodes,
+                limit: robots as usize + 1 + SPARE_AGENT_PLACES,
                 what: "nodes",
             },
             other => TransportError::iceoryx(format!("opening service {name}"), other),

@@ -2,9 +2,9 @@
 //! and one slot per robot.
 //!
 //! Only control words live here (tick, per-chain wake words, acknowledgement counter, join and death flags);
-//! frames and commands travel through iceoryx2 blackboards. The world creates the block, agents map it. Every
-//! field is an atomic, so the mapping is shared freely between threads and processes; a zero-filled block is a
-//! valid empty block.
+//! frames travel through iceoryx2 blackboards, commands through the run's command slots (`command_slots`). The
+//! world creates the block, agents map it. Every field is an atomic, so the mapping is shared freely between
+//! threads and processes; a zero-filled block is a valid empty block.
 //!
 //! Agents are woken chain by chain: the robots form chains of consecutive indices, and every agent of a chain
 //! sleeps on the chain's wake word. Once a chain's frames are in place the world sets the word to the tick and
@@ -19,21 +19,19 @@
 //! to an earlier tick can never be mistaken for an answer to the current one. Each robot is accounted for at
 //! most once per tick: by its agent's answer or by a death notice, whichever claims it first.
 
-use std::fs::OpenOptions;
-use std::os::fd::AsRawFd;
-use std::path::{Path, PathBuf};
-use std::ptr::NonNull;
+use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use super::TransportError;
 use super::futex::{self, LineWord};
+use super::shared_map::SharedMap;
 use super::world_watch::WorldEndNotice;
 
 /// Identifies a sync block file ("SWARMLCK").
 const MAGIC: u64 = 0x5357_4152_4d4c_434b;
 /// Layout version of the sync block.
-const LAYOUT_VERSION: u32 = 10;
+const LAYOUT_VERSION: u32 = 11;
 /// Bits of the acknowledgement word that count robots; the remaining top bits tag the tick.
 const COUNT_BITS: u32 = 20;
 /// Mask of the count bits.
@@ -59,7 +57,7 @@ struct Header {
     pin_chains: AtomicU32,
     /// 1 when each agent runs at real-time priority (`LinkConfig::realtime`).
     realtime: AtomicU32,
-    /// 1 when the run has mail boards (`LinkConfig::mail`).
+    /// 1 when the run carries mail: an inbox board and an outbox per robot (`LinkConfig::mail`).
     mail: AtomicU32,
     /// Current tick (full width), written before the tick's first chain starts; a chain's frames are in place
     /// once its wake word carries the tick.
@@ -70,8 +68,6 @@ struct Header {
     joined: LineWord,
     /// Non-zero once the world ends the run.
     stop: LineWord,
-    /// Count of replacement agents' requests for a fresh command board; the world polls it once per tick.
-    board_requests: LineWord,
 }
 
 /// Per-robot control words, one cache line per robot: the robot's agent and the world write here from
@@ -82,17 +78,11 @@ struct RobotSlot {
     answered: AtomicU64,
     /// 1 while an agent owns this robot.
     owner: AtomicU32,
-    /// Process id of the agent that last claimed this robot.
+    /// Process id of the agent that last claimed this robot: the only process whose commands count for it
+    /// (`command_slots`), until another agent claims it.
     owner_pid: AtomicU32,
     /// 1 after a death notice, until a replacement agent joins.
     dead: AtomicU32,
-    /// 1 once an agent has opened this robot's command board: from then on a replacement needs a fresh board,
-    /// since the board's single writer slot may be held by the dead agent. At start-up every robot has a
-    /// death notice but an untouched board.
-    used: AtomicU32,
-    /// Generation + 1 of the robot's command board an agent may open; 0 while the world replaces it after a
-    /// death (a board's single writer slot stays taken by a dead writer, so a replacement gets a fresh board).
-    board: AtomicU32,
     /// In the first robot of a chain only: the chain's wake word, the low 32 bits of the last tick whose frames
     /// of the chain are in place. Every agent of the chain sleeps on it.
     chain_go: AtomicU32,
@@ -107,23 +97,17 @@ pub(crate) struct AgentPlacement {
     pub(crate) pin_chains: bool,
     /// Each agent runs at real-time priority.
     pub(crate) realtime: bool,
-    /// The run has an inbox board and outbox entries (`crate::mail`).
+    /// The run has an inbox board and an outbox per robot (`crate::mail`).
     pub(crate) mail: bool,
 }
 
 /// A mapping of a run's sync block.
 pub(crate) struct SyncBlock {
-    base: NonNull<u8>,
-    len: usize,
+    map: SharedMap,
     capacity: u32,
     /// Robots per chain (a copy of the header's, which never changes).
     chain_len: u32,
 }
-
-// SAFETY: the mapping is only accessed through atomics, and it stays mapped until the SyncBlock is dropped.
-unsafe impl Send for SyncBlock {}
-// SAFETY: as above; every access is an atomic operation.
-unsafe impl Sync for SyncBlock {}
 
 /// Whether a robot could be claimed by a new agent.
 pub(crate) enum JoinClaim {
@@ -147,19 +131,16 @@ impl SyncBlock {
         chain_len: u32,
         placement: AgentPlacement,
     ) -> Result<SyncBlock, TransportError> {
-        let io_err = |source| TransportError::SyncBlock {
+        let len = Self::size_for(capacity);
+        let map = SharedMap::create(path, len).map_err(|source| TransportError::SyncBlock {
             path: path.to_path_buf(),
             source,
+        })?;
+        let block = SyncBlock {
+            map,
+            capacity,
+            chain_len: chain_len.max(1),
         };
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create_new(true)
-            .open(path)
-            .map_err(io_err)?;
-        let len = Self::size_for(capacity);
-        file.set_len(len as u64).map_err(io_err)?;
-        let block = Self::map(path, &file, len, capacity, chain_len.max(1))?;
         let header = block.header();
         header.version.store(LAYOUT_VERSION, Ordering::Relaxed);
         header.capacity.store(capacity, Ordering::Relaxed);
@@ -176,40 +157,31 @@ impl SyncBlock {
         header
             .world_pid
             .store(std::process::id(), Ordering::Relaxed);
-        for robot in 0..capacity {
-            block.publish_board(robot, 0);
-        }
         header.magic.store(MAGIC, Ordering::Release);
         Ok(block)
     }
 
     /// Maps the existing block of a run.
     pub(crate) fn open(path: &Path) -> Result<SyncBlock, TransportError> {
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(path)
-            .map_err(|source| TransportError::SyncBlock {
-                path: path.to_path_buf(),
-                source,
-            })?;
+        let io_err = |source| TransportError::SyncBlock {
+            path: path.to_path_buf(),
+            source,
+        };
         let invalid = |reason: String| TransportError::InvalidSyncBlock {
             path: path.to_path_buf(),
             reason,
         };
-        let file_len = file
-            .metadata()
-            .map_err(|source| TransportError::SyncBlock {
-                path: path.to_path_buf(),
-                source,
-            })?
-            .len();
+        let (file, file_len) = SharedMap::open_file(path).map_err(io_err)?;
         if file_len < size_of::<Header>() as u64 {
             return Err(invalid(format!(
                 "{file_len} bytes is too short for a header"
             )));
         }
-        let header_only = Self::map(path, &file, size_of::<Header>(), 0, 1)?;
+        let header_only = SyncBlock {
+            map: SharedMap::map(&file, size_of::<Header>()).map_err(io_err)?,
+            capacity: 0,
+            chain_len: 1,
+        };
         let header = header_only.header();
         if header.magic.load(Ordering::Acquire) != MAGIC {
             return Err(invalid("not a swarm lockstep block (bad magic)".into()));
@@ -229,40 +201,8 @@ impl SyncBlock {
         }
         let chain_len = header.chain_len.load(Ordering::Relaxed).max(1);
         drop(header_only);
-        Self::map(path, &file, len, capacity, chain_len)
-    }
-
-    fn map(
-        path: &Path,
-        file: &std::fs::File,
-        len: usize,
-        capacity: u32,
-        chain_len: u32,
-    ) -> Result<SyncBlock, TransportError> {
-        // SAFETY: a fresh shared mapping of an open file descriptor; the kernel picks the address.
-        let ptr = unsafe {
-            libc::mmap(
-                std::ptr::null_mut(),
-                len,
-                libc::PROT_READ | libc::PROT_WRITE,
-                libc::MAP_SHARED,
-                file.as_raw_fd(),
-                0,
-            )
-        };
-        if ptr == libc::MAP_FAILED {
-            return Err(TransportError::SyncBlock {
-                path: PathBuf::from(path),
-                source: std::io::Error::last_os_error(),
-            });
-        }
-        let base = NonNull::new(ptr.cast::<u8>()).ok_or_else(|| TransportError::SyncBlock {
-            path: PathBuf::from(path),
-            source: std::io::Error::other("mmap returned null"),
-        })?;
         Ok(SyncBlock {
-            base,
-            len,
+            map: SharedMap::map(&file, len).map_err(io_err)?,
             capacity,
             chain_len,
         })
@@ -270,7 +210,7 @@ impl SyncBlock {
 
     fn header(&self) -> &Header {
         // SAFETY: the mapping is at least one page-aligned header long and zero or validly initialised.
-        unsafe { &*self.base.as_ptr().cast::<Header>() }
+        unsafe { &*self.map.base().cast::<Header>() }
     }
 
     fn slot(&self, robot: u32) -> &RobotSlot {
@@ -278,8 +218,8 @@ impl SyncBlock {
         // SAFETY: robot < capacity, and the mapping holds `capacity` slots after the header.
         unsafe {
             &*self
-                .base
-                .as_ptr()
+                .map
+                .base()
                 .add(size_of::<Header>())
                 .cast::<RobotSlot>()
                 .add(robot as usize)
@@ -483,63 +423,6 @@ impl SyncBlock {
         self.claim(robot, tick);
     }
 
-    /// A replacement agent for `robot` asks for a fresh command board: its dead predecessor may still hold the
-    /// current board's single writer slot.
-    pub(crate) fn request_board(&self, robot: u32) {
-        self.slot(robot).board.store(0, Ordering::SeqCst);
-        let header = self.header();
-        header.board_requests.0.fetch_add(1, Ordering::AcqRel);
-        // A world waiting for agents sleeps on the join word: wake it to serve the request.
-        futex::wake(&header.joined.0, 1);
-    }
-
-    /// Number of fresh command boards requested so far.
-    pub(crate) fn board_requests(&self) -> u32 {
-        self.header().board_requests.0.load(Ordering::Acquire)
-    }
-
-    /// Whether `robot`'s replacement agent waits for a fresh command board.
-    pub(crate) fn board_requested(&self, robot: u32) -> bool {
-        self.slot(robot).board.load(Ordering::Acquire) == 0
-    }
-
-    /// Generation `generation` of `robot`'s command board exists: agents may open it.
-    pub(crate) fn publish_board(&self, robot: u32, generation: u32) {
-        let board = &self.slot(robot).board;
-        board.store(generation + 1, Ordering::Release);
-        futex::wake(board, i32::MAX);
-    }
-
-    /// Waits until `robot`'s command board may be opened and returns its generation; `None` if `deadline`
-    /// passes first.
-    pub(crate) fn wait_board(&self, robot: u32, deadline: Instant) -> Option<u32> {
-        let board = &self.slot(robot).board;
-        loop {
-            let current = board.load(Ordering::Acquire);
-            if current != 0 {
-                return Some(current - 1);
-            }
-            let now = Instant::now();
-            if now >= deadline {
-                return None;
-            }
-            futex::wait(board, 0, Some(deadline - now));
-        }
-    }
-
-    /// An agent is about to open `robot`'s command board.
-    pub(crate) fn mark_used(&self, robot: u32) {
-        self.slot(robot).used.store(1, Ordering::Release);
-    }
-
-    /// Whether an agent joining for `robot` must ask for a fresh command board: the robot has a death notice
-    /// and an agent has opened its board before (the dead one may still hold the board's writer slot). At
-    /// start-up every robot has a death notice, but no agent has touched its board.
-    pub(crate) fn needs_fresh_board(&self, robot: u32) -> bool {
-        let slot = self.slot(robot);
-        slot.dead.load(Ordering::Acquire) != 0 && slot.used.load(Ordering::Acquire) != 0
-    }
-
     /// Whether `robot` has a death notice and no replacement yet.
     pub(crate) fn is_dead(&self, robot: u32) -> bool {
         self.slot(robot).dead.load(Ordering::Acquire) != 0
@@ -549,6 +432,12 @@ impl SyncBlock {
     pub(crate) fn has_agent(&self, robot: u32) -> bool {
         let slot = self.slot(robot);
         slot.owner.load(Ordering::Acquire) == 1 && slot.dead.load(Ordering::Acquire) == 0
+    }
+
+    /// The process id of the agent that last claimed `robot` (0: none yet), whether or not it still owns it.
+    #[unsafe(link_section = "swarm_hot")]
+    pub(crate) fn claimer(&self, robot: u32) -> u32 {
+        self.slot(robot).owner_pid.load(Ordering::Acquire)
     }
 
     /// The process id of `robot`'s agent, if one owns the robot.
@@ -621,8 +510,8 @@ impl SyncBlock {
         }
     }
 
-    /// Waits until `count` agents have joined, `deadline` passes, 100 ms pass, or someone wakes the join word
-    /// (an agent joining or asking for a command board); returns the number joined. Callers loop.
+    /// Waits until `count` agents have joined, `deadline` passes, 100 ms pass, or an agent joining wakes the
+    /// join word; returns the number joined. Callers loop.
     pub(crate) fn wait_joined(&self, count: u32, deadline: Instant) -> u32 {
         let joined = &self.header().joined.0;
         let current = joined.load(Ordering::Acquire);
@@ -702,22 +591,13 @@ impl SyncBlock {
 }
 
 /// Whether process `pid` exists (a zombie not yet reaped still does).
-fn process_exists(pid: u32) -> bool {
+pub(crate) fn process_exists(pid: u32) -> bool {
     let Ok(pid) = libc::pid_t::try_from(pid) else {
         return false;
     };
     // SAFETY: signal 0 only checks that the process exists; nothing is delivered.
     let result = unsafe { libc::kill(pid, 0) };
     result == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
-}
-
-impl Drop for SyncBlock {
-    fn drop(&mut self) {
-        // SAFETY: base/len are exactly what mmap returned; nothing borrows the mapping past its owner.
-        unsafe {
-            libc::munmap(self.base.as_ptr().cast(), self.len);
-        }
-    }
 }
 
 /// The tick tag stored in the acknowledgement word.
@@ -760,30 +640,6 @@ mod tests {
         fn drop(&mut self) {
             let _ = std::fs::remove_file(&self.path);
         }
-    }
-
-    #[test]
-    fn only_a_replacement_needs_a_fresh_command_board() {
-        let path = PathBuf::from(format!(
-            "/dev/shm/swarm-test-{}-fresh-board",
-            std::process::id()
-        ));
-        let test = TestBlock {
-            block: SyncBlock::create(&path, 2, 2, AgentPlacement::default())
-                .expect("create the block"),
-            path,
-        };
-        let block = &test.block;
-        // Start-up: every robot has a death notice until its agent joins, and its board is untouched.
-        block.mark_dead(0);
-        assert!(!block.needs_fresh_board(0));
-        block.mark_used(0);
-        block.announce_ready(0);
-        assert!(!block.needs_fresh_board(0));
-        // The agent dies: its replacement needs a fresh board.
-        block.mark_dead(0);
-        assert!(block.needs_fresh_board(0));
-        assert!(!block.needs_fresh_board(1));
     }
 
     #[test]

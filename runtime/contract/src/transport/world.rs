@@ -1,6 +1,6 @@
 //! The world's side of the lockstep: creates every service of the run with explicit limits, writes each tick's
 //! frames into the frame board, wakes the agents, waits on one counter and reads each robot's command from its
-//! own command board.
+//! own command slot.
 //!
 //! It must never let a dead or frozen robot block a tick (death notices and the tick deadline), never accept a
 //! command into a slot other than its robot's, and never let arrival order change what it reads.
@@ -10,15 +10,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::reader::{EntryHandle, Reader};
 use iceoryx2::port::writer::{EntryHandleMut, Writer};
 use iceoryx2::prelude::{ZeroCopySend, ipc};
 
 use super::TransportError;
 use super::cleaner::Cleaner;
+use super::command_slots::CommandSlots;
 use super::placement;
 use super::run::RunSpec;
-use super::services::{self, Board, COMMAND_KEY, OUTBOX_KEY};
+use super::services::{self, Board};
 use super::sync_block::{AgentPlacement, MAX_ROBOTS, SyncBlock};
 use crate::mail::Mailbox;
 use crate::messages::{ActuatorCommand, SensorFrame};
@@ -44,8 +44,8 @@ pub struct LinkConfig {
     /// How long the world busy-waits for answers before it sleeps on the counter (default 20 us). Spinning
     /// saves a wake-up when agents answer fast; longer spins steal the CPU the agents need on small machines.
     pub spin: Duration,
-    /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice or a
-    /// replacement agent's request triggers one at once as well. Removals run on a thread of their own.
+    /// Ticks between two removals of dead nodes' iceoryx2 resources (default 1000); a death notice triggers one
+    /// at once as well. Removals run on a thread of their own.
     pub cleanup_interval: u64,
     /// Number of chains the robots are woken in (0: chosen from the robot count, see
     /// [`LinkConfig::chain_len`]). The world wakes one agent of each chain once its frames are written; that
@@ -62,8 +62,8 @@ pub struct LinkConfig {
     /// (default false). Set it once the thread that ticks the link runs at
     /// [`WORLD_PRIORITY`](super::priority::WORLD_PRIORITY): see [`priority`](super::priority).
     pub realtime: bool,
-    /// Whether the run carries addressed messages (`crate::mail`): an inbox board and an outbox entry on every
-    /// command board (default false: a run without a `<messages>` medium pays nothing for them).
+    /// Whether the run carries addressed messages (`crate::mail`): an inbox board and an outbox beside every
+    /// command slot (default false: a run without a `<messages>` medium pays nothing for them).
     pub mail: bool,
 }
 
@@ -157,47 +157,6 @@ impl DeathNotices {
     }
 }
 
-/// The world's reading end of one robot's command board. Fields drop in declaration order: entry, port, service.
-struct CommandBoard {
-    entry: EntryHandle<ipc::Service, u32, ActuatorCommand>,
-    outbox: Option<EntryHandle<ipc::Service, u32, Mailbox>>,
-    _reader: Reader<ipc::Service, u32>,
-    _board: Board,
-    generation: u32,
-}
-
-impl CommandBoard {
-    fn create(
-        node: &Node<ipc::Service>,
-        robot: u32,
-        generation: u32,
-        mail: bool,
-    ) -> Result<CommandBoard, TransportError> {
-        let board = services::create_command_board(node, robot, generation, mail)?;
-        let reader = board
-            .reader_builder()
-            .create()
-            .map_err(|e| TransportError::iceoryx(format!("reading robot {robot}'s commands"), e))?;
-        let entry = reader
-            .entry::<ActuatorCommand>(&COMMAND_KEY)
-            .map_err(|e| TransportError::iceoryx(format!("robot {robot}'s command entry"), e))?;
-        let outbox = mail
-            .then(|| {
-                reader.entry::<Mailbox>(&OUTBOX_KEY).map_err(|e| {
-                    TransportError::iceoryx(format!("robot {robot}'s outbox entry"), e)
-                })
-            })
-            .transpose()?;
-        Ok(CommandBoard {
-            entry,
-            outbox,
-            _reader: reader,
-            _board: board,
-            generation,
-        })
-    }
-}
-
 /// The world's writing end of the inbox board (runs with mail only). Fields drop in declaration order.
 struct InboxBoard {
     entries: Vec<EntryHandleMut<ipc::Service, u32, Mailbox>>,
@@ -205,12 +164,10 @@ struct InboxBoard {
     _board: Board,
 }
 
-/// The world's iceoryx2 ports: one frame-board entry and one command board per robot, indexed by robot, and
-/// the inbox board in runs with mail. Entry handles keep their ports and services alive; the other fields are
-/// only held, in drop order.
+/// The world's iceoryx2 ports: one frame-board entry per robot, indexed by robot, and the inbox board in runs
+/// with mail. Entry handles keep their ports and services alive; the other fields are only held, in drop order.
 struct Boards {
     frame_entries: Vec<EntryHandleMut<ipc::Service, u32, SensorFrame>>,
-    commands: Vec<CommandBoard>,
     inboxes: Option<InboxBoard>,
     _frame_writer: Writer<ipc::Service, u32>,
     _frame_board: Board,
@@ -221,17 +178,21 @@ pub struct WorldLink {
     config: LinkConfig,
     tick: u64,
     boards: Boards,
+    /// Every robot's command slot.
+    slots: CommandSlots,
     /// This tick's frames, filled by the caller and then written to the board.
     frames: Vec<SensorFrame>,
     /// The last tick's commands, valid where `status` says `Answered`.
     commands: Vec<ActuatorCommand>,
+    /// The state word of each robot's slot the last tick's command was read under (for its outbox).
+    read_states: Vec<u64>,
     status: Vec<CommandStatus>,
     deaths: DeathNotices,
     notices_handled: u64,
-    board_requests_handled: u32,
     last_cleanup: u64,
     cleaner: Cleaner,
-    node: Node<ipc::Service>,
+    /// The world's iceoryx2 node, held for the boards.
+    _node: Node<ipc::Service>,
     /// The CPU of each chain's agents, when they pin themselves ([`LinkConfig::pin_chains`]); empty otherwise.
     chain_cpus: Vec<usize>,
     /// Messages posted to each robot's inbox for the next tick ([`WorldLink::post`]); its frame says how many.
@@ -251,8 +212,10 @@ impl WorldLink {
         let node = services::node(run, "world")?;
         let boards = Self::create_boards(&node, robots, config.mail)?;
         let cleaner = Cleaner::start(run.iceoryx_config()?)?;
-        // Last, so that a failure above leaves no sync block behind (iceoryx2 removes its own resources on drop).
-        let sync = Arc::new(SyncBlock::create(
+        // Last, so that a failure above leaves no file of ours behind (iceoryx2 removes its own resources on
+        // drop); the sync block after the slots, since agents that find it open the slots.
+        let slots = CommandSlots::create(&run.command_slots_path(), robots, config.mail)?;
+        let sync = SyncBlock::create(
             &run.sync_block_path(),
             robots,
             config.chain_len(),
@@ -261,7 +224,11 @@ impl WorldLink {
                 realtime: config.realtime,
                 mail: config.mail,
             },
-        )?);
+        )
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(run.command_slots_path());
+        })?;
+        let sync = Arc::new(sync);
         let chain_cpus = if config.pin_chains {
             placement::chain_cpus(sync.chains().count()).unwrap_or_default()
         } else {
@@ -271,18 +238,19 @@ impl WorldLink {
         Ok(WorldLink {
             tick: 0,
             boards,
+            slots,
             frames: (0..robots).map(SensorFrame::empty).collect(),
             commands: (0..robots).map(|r| ActuatorCommand::idle(r, 0)).collect(),
+            read_states: vec![0; robots as usize],
             status: vec![CommandStatus::Missing; robots as usize],
             deaths: DeathNotices {
                 sync,
                 notices: Arc::new(AtomicU64::new(0)),
             },
             notices_handled: 0,
-            board_requests_handled: 0,
             last_cleanup: 0,
             cleaner,
-            node,
+            _node: node,
             config,
             chain_cpus,
             posted: vec![0; robots as usize],
@@ -297,15 +265,11 @@ impl WorldLink {
         let frame_board = services::create_frame_board(node, robots)?;
         let (frame_writer, frame_entries) =
             every_entry::<SensorFrame>(&frame_board, robots, "frame")?;
-        let commands = (0..robots)
-            .map(|robot| CommandBoard::create(node, robot, 0, mail))
-            .collect::<Result<Vec<_>, _>>()?;
         let inboxes = mail
             .then(|| Self::create_inboxes(node, robots))
             .transpose()?;
         Ok(Boards {
             frame_entries,
-            commands,
             inboxes,
             _frame_writer: frame_writer,
             _frame_board: frame_board,
@@ -343,14 +307,14 @@ impl WorldLink {
         }
     }
 
-    /// Blocks until every robot has an agent or `timeout` passes, giving replacement agents that join meanwhile
-    /// their fresh command boards.
+    /// Blocks until every robot has an agent or `timeout` passes. Death notices meanwhile have the dead agents'
+    /// iceoryx2 resources removed, which frees their places in the frame board for their replacements.
     pub fn wait_for_agents(&mut self, timeout: Duration) -> Result<(), TransportError> {
         let start = Instant::now();
         let deadline = start + timeout;
         let expected = self.config.robots;
         loop {
-            self.serve_board_requests();
+            self.clean_up_after_notices();
             let joined = self.deaths.sync.wait_joined(expected, deadline);
             if joined >= expected {
                 return Ok(());
@@ -365,19 +329,20 @@ impl WorldLink {
         }
     }
 
-    /// Renews the command boards replacement agents asked for, and has the dead agents' iceoryx2 resources
-    /// removed (their places in the frame board; the frame board's spare places let replacements in before).
-    fn serve_board_requests(&mut self) {
-        let requests = self.deaths.sync.board_requests();
-        if requests != self.board_requests_handled {
-            tracing::debug!(
-                requests = requests - self.board_requests_handled,
-                "fresh command boards requested"
-            );
-            self.board_requests_handled = requests;
-            self.renew_requested_boards();
-            self.cleaner.request();
+    /// Has the dead agents' iceoryx2 resources removed if death notices arrived since the last removal;
+    /// returns whether it asked for one.
+    fn clean_up_after_notices(&mut self) -> bool {
+        let notices = self.deaths.notices.load(Ordering::Acquire);
+        if notices == self.notices_handled {
+            return false;
         }
+        tracing::debug!(
+            notices = notices - self.notices_handled,
+            "dead-node cleanup requested"
+        );
+        self.notices_handled = notices;
+        self.cleaner.request();
+        true
     }
 
     /// A handle for death notices from other threads.
@@ -511,12 +476,13 @@ impl WorldLink {
         if command.outbox_len == 0 {
             return None;
         }
-        let board = self.boards.commands.get(robot as usize)?;
-        let outbox = *board.outbox.as_ref()?.get();
+        let outbox = self
+            .slots
+            .read_outbox(robot, self.read_states[robot as usize])?;
         (outbox.tick == command.tick && outbox.owner == robot).then_some(outbox)
     }
 
-    /// Reads each robot's command for `tick` from its own board into its slot.
+    /// Reads each robot's command for `tick` from its own command slot.
     fn collect(&mut self, tick: u64) -> TickOutcome {
         let mut outcome = TickOutcome {
             tick,
@@ -524,57 +490,37 @@ impl WorldLink {
             missing: 0,
             dead: 0,
         };
-        for (robot, board) in self.boards.commands.iter().enumerate() {
-            let command = *board.entry.get();
-            // A late answer to an earlier tick is not this tick's answer; the board has a single writer, the
-            // robot's agent, so `robot` can only be wrong if the agent is broken.
-            self.status[robot] = if command.tick == tick && command.robot == robot as u32 {
-                self.commands[robot] = command;
-                outcome.answered += 1;
-                CommandStatus::Answered
-            } else if self.deaths.sync.is_dead(robot as u32) {
-                outcome.dead += 1;
-                CommandStatus::Dead
-            } else {
-                outcome.missing += 1;
-                CommandStatus::Missing
+        for robot in 0..self.config.robots {
+            let r = robot as usize;
+            // A late answer to an earlier tick is not this tick's answer; only the robot's agent writes its slot,
+            // so `robot` can only be wrong if the agent is broken. A slot being written has no answer yet.
+            self.status[r] = match self.slots.read(robot) {
+                Some((command, state)) if command.tick == tick && command.robot == robot => {
+                    self.commands[r] = command;
+                    self.read_states[r] = state;
+                    outcome.answered += 1;
+                    CommandStatus::Answered
+                }
+                _ if self.deaths.sync.is_dead(robot) => {
+                    outcome.dead += 1;
+                    CommandStatus::Dead
+                }
+                _ => {
+                    outcome.missing += 1;
+                    CommandStatus::Missing
+                }
             };
         }
         outcome
     }
 
+    /// Has dead nodes removed after death notices, and every [`LinkConfig::cleanup_interval`] ticks (requests
+    /// are merged, so asking twice costs nothing).
     fn cleanup_if_due(&mut self, tick: u64) {
-        self.serve_board_requests();
-        let notices = self.deaths.notices.load(Ordering::Acquire);
-        if notices != self.notices_handled
-            || tick - self.last_cleanup >= self.config.cleanup_interval
-        {
-            tracing::debug!(
-                tick,
-                notices = notices - self.notices_handled,
-                "dead-node cleanup requested"
-            );
-            self.notices_handled = notices;
-            self.last_cleanup = tick;
+        let after_notices = self.clean_up_after_notices();
+        if after_notices || tick - self.last_cleanup >= self.config.cleanup_interval {
             self.cleaner.request();
-        }
-    }
-
-    /// Gives every robot whose replacement agent asked for one a fresh command board.
-    fn renew_requested_boards(&mut self) {
-        let sync = &self.deaths.sync;
-        for (robot, board) in (0..).zip(self.boards.commands.iter_mut()) {
-            if !sync.board_requested(robot) {
-                continue;
-            }
-            let generation = board.generation + 1;
-            match CommandBoard::create(&self.node, robot, generation, self.config.mail) {
-                Ok(fresh) => {
-                    *board = fresh;
-                    sync.publish_board(robot, generation);
-                }
-                Err(e) => tracing::warn!(robot, generation, "replacing a command board: {e}"),
-            }
+            self.last_cleanup = tick;
         }
     }
 
