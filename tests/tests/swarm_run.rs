@@ -642,10 +642,10 @@ fn a_misspelt_controller_parameter_is_warned_with_a_suggestion() {
     );
 }
 
-/// A run that needs more open files than the machine allows is refused before it starts, with what to do, not
-/// with a transport error from deep inside the world.
+/// No process of a run holds descriptors per robot (the command slots are one file; iceoryx2's per-robot files are
+/// the agents' own): 1,000 robots run under a limit of 64 open files per process, far below the usual 1,024.
 #[test]
-fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
+fn a_thousand_robots_run_within_64_open_files_per_process() {
     use std::os::unix::process::CommandExt;
     let out = temp_dir();
     let dir = bin_dir();
@@ -653,9 +653,9 @@ fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
     command
         .args([
             "run",
-            "configs/obstacle_avoidance/density_N100.argos",
+            "configs/obstacle_avoidance/density_N1000.argos",
             "--ticks",
-            "1",
+            "2",
             "--no-progress",
             "--out",
         ])
@@ -666,8 +666,8 @@ fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
     unsafe {
         command.pre_exec(|| {
             let limit = libc::rlimit {
-                rlim_cur: 300,
-                rlim_max: 300,
+                rlim_cur: 64,
+                rlim_max: 64,
             };
             if libc::setrlimit(libc::RLIMIT_NOFILE, &limit) == 0 {
                 Ok(())
@@ -678,14 +678,10 @@ fn a_run_beyond_the_open_file_limit_is_refused_up_front_with_what_to_do() {
     }
     let output = command.output().expect("swarm runs");
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success());
-    assert!(
-        stderr.contains(
-            "100 robots need about 728 open files, but this process may open at most 300"
-        ),
-        "{stderr}"
-    );
-    assert!(!out.path().join("summary.json").exists(), "nothing started");
+    assert!(output.status.success(), "{stderr}");
+    let summary = summary(out.path());
+    assert_eq!(summary["robots"], 1000, "{summary}");
+    assert_eq!(summary["commands_missing"], 0, "{summary}");
 }
 
 /// Off a terminal the progress bar cannot be drawn: the run logs plain progress lines instead, at a low rate.

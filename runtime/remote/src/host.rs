@@ -475,10 +475,6 @@ impl Share {
         sender: &Sender<Event>,
     ) -> Result<Share, RemoteError> {
         let count = assignment.robots.len() as u32;
-        swarm_contract::process::open_files::ensure(count).map_err(|e| RemoteError::Refused {
-            host: options.name.clone(),
-            reason: e.to_string(),
-        })?;
         if count > options.capacity {
             return Err(RemoteError::Refused {
                 host: options.name.clone(),

@@ -99,7 +99,6 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     // coordinators; the world simulates the robots' bodies only.
     let bodies = world.robot_count();
     let robots = world.participant_count();
-    swarm_contract::process::open_files::ensure(robots as u32)?;
     let schedule = FaultSchedule::for_run(&experiment, &args.faults, robots as u32)?;
     world.set_dead_bodies(schedule.dead_bodies);
     let roster: Vec<(String, String)> = experiment

@@ -182,9 +182,6 @@ pub enum LaunchError {
     /// The configuration could not be rewritten as the run used it.
     #[error("{0}")]
     AsRun(String),
-    /// The run needs more open files than this machine allows.
-    #[error(transparent)]
-    OpenFiles(#[from] swarm_contract::process::open_files::TooManyFiles),
     /// The run directory cannot be used.
     #[error(transparent)]
     RunDir(#[from] RunDirError),
@@ -268,8 +265,6 @@ pub fn run(options: &RunOptions, stop: Arc<AtomicBool>) -> Result<RunReport, Lau
         });
     }
     let robots = roster.len() as u32;
-    // Raised here, inherited by the world (which holds a few descriptors per robot) and the agents.
-    swarm_contract::process::open_files::ensure(robots)?;
     let seed = options
         .seed
         .or(experiment.framework.random_seed)
