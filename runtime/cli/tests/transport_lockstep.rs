@@ -42,6 +42,13 @@ impl Run {
         self.children.push(child);
     }
 
+    /// Sends `signal` to the `index`-th agent started.
+    fn signal(&self, index: usize, signal: libc::c_int) {
+        let pid = libc::pid_t::try_from(self.children[index].id()).expect("a pid");
+        // SAFETY: kill(2) with a valid signal on our own child.
+        assert_eq!(unsafe { libc::kill(pid, signal) }, 0);
+    }
+
     fn kill_all(&mut self) {
         for child in &mut self.children {
             let _ = child.kill();
@@ -262,15 +269,8 @@ fn a_stopped_agent_holds_up_no_other_robot_of_its_chain() {
     // answers long before the deadline.
     let mut link_config = config(4, 20_000);
     link_config.chains = 2;
-    let mut world = WorldLink::create(&run.spec, link_config).expect("create world");
-    for robot in 0..4 {
-        run.spawn(robot, &[]);
-    }
-    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
-    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 4);
-    let stopped = libc::pid_t::try_from(run.children[0].id()).expect("a pid");
-    // SAFETY: kill(2) with a valid signal on our own child.
-    assert_eq!(unsafe { libc::kill(stopped, libc::SIGSTOP) }, 0);
+    let mut world = agents_after_one_tick(&mut run, link_config);
+    run.signal(0, libc::SIGSTOP);
     // As the fault driver does for a frozen robot: ticks stop waiting for it.
     world.mark_dead(0).expect("death notice");
     for tick in 2..=6 {
@@ -280,8 +280,7 @@ fn a_stopped_agent_holds_up_no_other_robot_of_its_chain() {
             expect_echo(&world, robot, tick);
         }
     }
-    // SAFETY: as above.
-    assert_eq!(unsafe { libc::kill(stopped, libc::SIGCONT) }, 0);
+    run.signal(0, libc::SIGCONT);
 }
 
 #[test]
@@ -384,16 +383,9 @@ fn replacement_agent_joins_after_a_death_notice_and_answers_again() {
 #[test]
 fn an_agent_continued_after_its_robot_was_replaced_is_not_counted() {
     let mut run = Run::new();
-    let mut world = WorldLink::create(&run.spec, config(2, 300)).expect("create world");
-    for robot in 0..2 {
-        run.spawn(robot, &[]);
-    }
-    world.wait_for_agents(JOIN_TIMEOUT).expect("agents join");
-    assert_eq!(world.tick_with(sense).expect("tick 1").answered, 2);
+    let mut world = agents_after_one_tick(&mut run, config(2, 300));
     // Robot 1's agent is stopped and reported, as the fault driver does for a frozen robot.
-    let stopped = libc::pid_t::try_from(run.children[1].id()).expect("a pid");
-    // SAFETY: kill(2) with a valid signal on our own child.
-    assert_eq!(unsafe { libc::kill(stopped, libc::SIGSTOP) }, 0);
+    run.signal(1, libc::SIGSTOP);
     world.mark_dead(1).expect("death notice");
     assert_eq!(world.tick_with(sense).expect("tick 2").dead, 1);
     // A replacement that joins and never answers: any answer for robot 1 now comes from the stopped agent.
@@ -401,8 +393,7 @@ fn an_agent_continued_after_its_robot_was_replaced_is_not_counted() {
     world
         .wait_for_agents(JOIN_TIMEOUT)
         .expect("replacement joins");
-    // SAFETY: as above.
-    assert_eq!(unsafe { libc::kill(stopped, libc::SIGCONT) }, 0);
+    run.signal(1, libc::SIGCONT);
     for tick in 3..=6 {
         let outcome = world.tick_with(sense).expect("tick");
         assert_eq!(
