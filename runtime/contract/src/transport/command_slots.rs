@@ -451,6 +451,22 @@ mod tests {
     }
 
     #[test]
+    fn a_file_too_short_for_its_robots_is_refused() {
+        let test = TestSlots::new("short", 4, true);
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&test.path)
+            .expect("open the file");
+        file.set_len(super::LINE as u64 + super::COMMAND_STRIDE as u64)
+            .expect("truncate");
+        let error = CommandSlots::open(&test.path).err().expect("refused");
+        assert!(
+            error.to_string().contains("cannot hold 4 robots"),
+            "{error}"
+        );
+    }
+
+    #[test]
     fn a_file_of_another_layout_is_refused_with_its_path() {
         let test = TestSlots::new("layout", 1, false);
         let header = test.slots.header();
