@@ -84,7 +84,7 @@ impl Tick<'_> {
         let link = self.link;
         let (robot, writer, tick) = (link.robot, link.pid, link.frame.tick);
         let mut posted = None;
-        if link.has_mail && link.mail.ports.is_some() {
+        if link.has_mail {
             let outbox = &link.mail.outbox;
             if !outbox.is_empty() {
                 let mut mailbox = *outbox;

@@ -243,10 +243,7 @@ impl CommandSlots {
                     )
                     .is_ok()
                 {
-                    fence(Ordering::Release);
-                    // SAFETY: the slot is taken by this process, so nobody else writes it.
-                    unsafe { self.command(robot).write(ActuatorCommand::idle(robot, 0)) };
-                    head.state.store(written(free), Ordering::Release);
+                    self.fill(robot, free, &ActuatorCommand::idle(robot, 0), None);
                     return Ok(());
                 }
                 continue;
@@ -293,16 +290,25 @@ impl CommandSlots {
             head.state.store(state, Ordering::Release);
             return false;
         }
+        self.fill(robot, state, command, outbox);
+        true
+    }
+
+    /// With `robot`'s slot taken by the caller from the free state `free`: copies `command`, and `outbox` if the
+    /// run has mail, in and frees the slot with the count advanced.
+    #[unsafe(link_section = "swarm_hot")]
+    fn fill(&self, robot: u32, free: u64, command: &ActuatorCommand, outbox: Option<&Mailbox>) {
         // A reader that sees any byte written below sees the slot taken when it loads the state again.
         fence(Ordering::Release);
         if let (Some(outbox), Some(slot)) = (outbox, self.outbox(robot)) {
-            // SAFETY: the slot is taken by this writer; source and destination are distinct memory.
+            // SAFETY: the slot is taken by the caller; source and destination are distinct memory.
             unsafe { std::ptr::copy_nonoverlapping(outbox, slot, 1) };
         }
         // SAFETY: as above.
         unsafe { std::ptr::copy_nonoverlapping(command, self.command(robot), 1) };
-        head.state.store(written(state), Ordering::Release);
-        true
+        self.head(robot)
+            .state
+            .store(written(free), Ordering::Release);
     }
 
     /// World side: `robot`'s last command and the state word it was read under (for
@@ -313,30 +319,34 @@ impl CommandSlots {
         if holder(before) != 0 {
             return None;
         }
-        let mut copy = MaybeUninit::<ActuatorCommand>::uninit();
-        // SAFETY: the slot holds a command; a copy torn by a concurrent writer is detected below and dropped
-        // before it is used.
-        unsafe { std::ptr::copy_nonoverlapping(self.command(robot), copy.as_mut_ptr(), 1) };
-        fence(Ordering::Acquire);
-        // SAFETY: the state word did not change during the copy, so it is one whole command a writer stored.
-        (head.state.load(Ordering::Relaxed) == before)
-            .then(|| (unsafe { copy.assume_init() }, before))
+        Some((
+            self.copy_unchanged(robot, self.command(robot), before)?,
+            before,
+        ))
     }
 
     /// World side: `robot`'s outbox as written with the command [`CommandSlots::read`] returned with `state`;
     /// `None` without mail, or when the agent has written its slot since.
     pub(crate) fn read_outbox(&self, robot: u32, state: u64) -> Option<Mailbox> {
         let slot = self.outbox(robot)?;
-        let head = self.head(robot);
-        if head.state.load(Ordering::Acquire) != state {
+        if self.head(robot).state.load(Ordering::Acquire) != state {
             return None;
         }
-        let mut copy = MaybeUninit::<Mailbox>::uninit();
-        // SAFETY: as in `read`.
-        unsafe { std::ptr::copy_nonoverlapping(slot, copy.as_mut_ptr(), 1) };
+        self.copy_unchanged(robot, slot, state)
+    }
+
+    /// Copies the value at `from`, part of `robot`'s slot, whose state word the caller has just loaded (with
+    /// acquire ordering) as the free state `state`; `None` if the word has changed by the end of the copy, i.e. a
+    /// writer may have touched the value meanwhile.
+    fn copy_unchanged<T>(&self, robot: u32, from: *const T, state: u64) -> Option<T> {
+        let mut copy = MaybeUninit::<T>::uninit();
+        // SAFETY: `from` points at a value of the slot; a copy torn by a concurrent writer is detected below and
+        // dropped before it is used.
+        unsafe { std::ptr::copy_nonoverlapping(from, copy.as_mut_ptr(), 1) };
         fence(Ordering::Acquire);
-        // SAFETY: as in `read`.
-        (head.state.load(Ordering::Relaxed) == state).then(|| unsafe { copy.assume_init() })
+        // SAFETY: the state word did not change during the copy, so it is one whole value a writer stored.
+        (self.head(robot).state.load(Ordering::Relaxed) == state)
+            .then(|| unsafe { copy.assume_init() })
     }
 }
 

@@ -177,12 +177,12 @@ impl SyncBlock {
                 "{file_len} bytes is too short for a header"
             )));
         }
-        let header_only = SyncBlock {
-            map: SharedMap::map(&file, size_of::<Header>()).map_err(io_err)?,
+        let mut block = SyncBlock {
+            map: SharedMap::map(&file, file_len as usize).map_err(io_err)?,
             capacity: 0,
             chain_len: 1,
         };
-        let header = header_only.header();
+        let header = block.header();
         if header.magic.load(Ordering::Acquire) != MAGIC {
             return Err(invalid("not a swarm lockstep block (bad magic)".into()));
         }
@@ -199,13 +199,9 @@ impl SyncBlock {
                 "{file_len} bytes cannot hold {capacity} robots ({len} bytes)"
             )));
         }
-        let chain_len = header.chain_len.load(Ordering::Relaxed).max(1);
-        drop(header_only);
-        Ok(SyncBlock {
-            map: SharedMap::map(&file, len).map_err(io_err)?,
-            capacity,
-            chain_len,
-        })
+        block.chain_len = header.chain_len.load(Ordering::Relaxed).max(1);
+        block.capacity = capacity;
+        Ok(block)
     }
 
     fn header(&self) -> &Header {

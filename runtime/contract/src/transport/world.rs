@@ -314,7 +314,9 @@ impl WorldLink {
         let deadline = start + timeout;
         let expected = self.config.robots;
         loop {
-            self.clean_up_after_notices();
+            if self.take_new_notices() {
+                self.cleaner.request();
+            }
             let joined = self.deaths.sync.wait_joined(expected, deadline);
             if joined >= expected {
                 return Ok(());
@@ -329,9 +331,9 @@ impl WorldLink {
         }
     }
 
-    /// Has the dead agents' iceoryx2 resources removed if death notices arrived since the last removal;
-    /// returns whether it asked for one.
-    fn clean_up_after_notices(&mut self) -> bool {
+    /// Whether death notices arrived since the last call: their dead agents' iceoryx2 resources are to be
+    /// removed.
+    fn take_new_notices(&mut self) -> bool {
         let notices = self.deaths.notices.load(Ordering::Acquire);
         if notices == self.notices_handled {
             return false;
@@ -341,7 +343,6 @@ impl WorldLink {
             "dead-node cleanup requested"
         );
         self.notices_handled = notices;
-        self.cleaner.request();
         true
     }
 
@@ -514,11 +515,9 @@ impl WorldLink {
         outcome
     }
 
-    /// Has dead nodes removed after death notices, and every [`LinkConfig::cleanup_interval`] ticks (requests
-    /// are merged, so asking twice costs nothing).
+    /// Has dead nodes removed after death notices, and every [`LinkConfig::cleanup_interval`] ticks.
     fn cleanup_if_due(&mut self, tick: u64) {
-        let after_notices = self.clean_up_after_notices();
-        if after_notices || tick - self.last_cleanup >= self.config.cleanup_interval {
+        if self.take_new_notices() || tick - self.last_cleanup >= self.config.cleanup_interval {
             self.cleaner.request();
             self.last_cleanup = tick;
         }
