@@ -4,6 +4,7 @@
 use std::fs::{File, OpenOptions};
 use std::io;
 use std::os::fd::AsRawFd;
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 use std::ptr::NonNull;
 
@@ -20,12 +21,15 @@ unsafe impl Send for SharedMap {}
 unsafe impl Sync for SharedMap {}
 
 impl SharedMap {
-    /// Creates the file at `path` (failing if it exists) with `len` zero bytes and maps it.
+    /// Creates the file at `path` (failing if it exists) with `len` zero bytes and maps it. Only the run's user
+    /// may read or write the file (mode 0600, as iceoryx2 makes its own files): the words in it start, stop and
+    /// steer the run.
     pub(crate) fn create(path: &Path, len: usize) -> io::Result<SharedMap> {
         let file = OpenOptions::new()
             .read(true)
             .write(true)
             .create_new(true)
+            .mode(0o600)
             .open(path)?;
         file.set_len(len as u64)?;
         SharedMap::map(&file, len)
@@ -76,5 +80,23 @@ impl Drop for SharedMap {
         unsafe {
             libc::munmap(self.base.as_ptr().cast(), self.len);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::os::unix::fs::PermissionsExt;
+    use std::path::PathBuf;
+
+    use super::SharedMap;
+
+    #[test]
+    fn a_created_file_is_open_to_its_owner_only() {
+        let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-shared-map", std::process::id()));
+        let created = SharedMap::create(&path, 4096);
+        let mode = std::fs::metadata(&path).map(|m| m.permissions().mode() & 0o777);
+        let _ = std::fs::remove_file(&path);
+        created.expect("create the file");
+        assert_eq!(mode.expect("the file's mode"), 0o600);
     }
 }
