@@ -222,7 +222,16 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     }
     let ticking = started.elapsed().as_secs_f64();
     tracing::debug!("last tick done");
-    let cpu = cpu.map(|cpu| cpu.summary(&link, robot_steps));
+    // The agents' CPU accounts (a `/proc` file each, about 10 ms at 1,000 robots) are read while the record files
+    // are completed: both must be done before the agents are let go, and the records mostly wait for the
+    // recording thread.
+    let cpu_end = cpu.map(|cpu| cpu.end(&link, robot_steps));
+    let (cpu, records) = std::thread::scope(|scope| {
+        let reading = scope.spawn(|| cpu_end.map(|end| end.summary()));
+        let records = recorder.complete_records();
+        (reading.join().ok().flatten(), records)
+    });
+    records?;
     let ticks = link.tick();
     let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
@@ -248,9 +257,8 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
             object.extend(cpu);
         }
     }
-    // The record files first, while the agents still sleep (see `Recorder::complete_records`); then the agents
-    // exit while the final snapshot is drawn.
-    recorder.complete_records()?;
+    // The record files were completed while the agents still slept (see `Recorder::complete_records`); now the
+    // agents exit while the final snapshot is drawn.
     link.end();
     recorder.finish(&world, extra)?;
     report(WorldReport::Finished { ticks });

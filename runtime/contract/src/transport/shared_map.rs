@@ -92,7 +92,10 @@ mod tests {
 
     #[test]
     fn a_created_file_is_open_to_its_owner_only() {
-        let path = PathBuf::from(format!("/dev/shm/swarm-test-{}-shared-map", std::process::id()));
+        let path = PathBuf::from(format!(
+            "/dev/shm/swarm-test-{}-shared-map",
+            std::process::id()
+        ));
         let created = SharedMap::create(&path, 4096);
         let mode = std::fs::metadata(&path).map(|m| m.permissions().mode() & 0o777);
         let _ = std::fs::remove_file(&path);
