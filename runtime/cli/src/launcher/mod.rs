@@ -8,10 +8,12 @@
 //! robots -> create the run directory -> start the world (it creates every shared-memory service with limits
 //! for N robots and says `ready`) -> start the agents -> follow the world's tick reports on a progress bar; an agent
 //! that dies is reported to the world at once on its standard input (`dead <robot>`) -> when the world says
-//! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory.
+//! `finished`, collect the agents, complete `summary.json`, remove the run's shared memory. [`run`] does these
+//! steps in order; `supervision.rs` is the loop while the run goes, `summary.rs` the launcher's part of
+//! `summary.json`, `error.rs` why a run fails.
 //!
 //! Faults (docs/faults.md): the world paces the schedule and reports each due fault between two ticks; the
-//! launcher applies it to the processes ([`fault_handling`]), restarts agents by their [`restart`] policy, and
+//! launcher applies it to the processes (`fault_handling.rs`), restarts agents by their [`restart`] policy, and
 //! takes `swarm ctl` requests on the run's [`control`] socket. If the world dies, the launcher stops every agent,
 //! cuts the records back to the last complete tick ([`records`]), writes the summary and fails with the reason.
 
@@ -19,43 +21,46 @@ mod agents;
 mod arrivals;
 pub mod as_run;
 pub mod control;
+mod error;
 mod fault_handling;
 pub mod fault_log;
 mod plain_progress;
 pub mod records;
 pub mod restart;
+mod summary;
+mod supervision;
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, IsTerminal, Write};
+use std::io::{BufRead, BufReader, IsTerminal};
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::process::{ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::atomic::AtomicBool;
+use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use nix::sys::signal::Signal;
 
 use agents::{AgentSpawner, HeldAgents, RobotEntry, present_robots};
 use control::{ControlServer, CtlRequest};
+pub use error::LaunchError;
+use error::io;
 use fault_log::FaultRecord;
 use plain_progress::PlainProgress;
 use restart::RestartTracker;
+use summary::{Provenance, complete_summary};
+use swarm_contract::config::Experiment;
 use swarm_contract::config::faults::{FaultKind, FaultSchedule};
-use swarm_contract::config::{ConfigErrors, Experiment};
 use swarm_contract::disk_budget::DiskBudget;
 use swarm_contract::fault_plan::FaultPlan;
-use swarm_contract::limits::LimitError;
-use swarm_contract::process::binaries::{Binaries, BinariesError};
+use swarm_contract::process::binaries::Binaries;
 use swarm_contract::process::children::{self, Children};
 use swarm_contract::protocol::launcher_to_agent::{AgentArgs, RunArgs};
-use swarm_contract::protocol::launcher_to_world::WorldCommand;
 use swarm_contract::protocol::launcher_to_world::{Records, WorldArgs};
 use swarm_contract::protocol::world_to_launcher::WorldReport;
-use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE, RunDirError};
-use swarm_contract::transport::{self, RunSpec};
+use swarm_contract::run_dir::{self, COMPILED_SUPERVISORS_DIR, EVENT_TABLES_FILE};
+use swarm_contract::transport::RunSpec;
 use swarm_remote::plan::{Authentication, HostsArgs, HostsError, HostsPlan};
 
 /// How often the supervision loop looks at its children when the world is quiet.
@@ -138,98 +143,6 @@ pub struct Death {
     pub after_tick: u64,
     /// How the process ended.
     pub status: String,
-}
-
-/// Why a run failed.
-#[derive(Debug, thiserror::Error)]
-pub enum LaunchError {
-    /// The configuration is invalid.
-    #[error("{0}")]
-    Config(#[from] ConfigErrors),
-    /// The configuration has no robot to run.
-    #[error(
-        "{path}:{at}: the arena has no robot (e-puck, foot-bot or disc-robot), so there is nothing to run"
-    )]
-    NoRobots {
-        /// The configuration.
-        path: PathBuf,
-        /// Where its `<arena>` element is.
-        at: swarm_contract::config::model::Location,
-    },
-    /// The world or agent programs are missing.
-    #[error(transparent)]
-    Binaries(#[from] BinariesError),
-    /// The hosts of the run cannot be resolved.
-    #[error(transparent)]
-    Hosts(#[from] HostsError),
-    /// The world stopped the run before its end to stay within its disk budget; the records up to `ticks` are
-    /// complete.
-    #[error(
-        "stopped after {ticks} ticks: {reason}; the records up to that tick are complete in {}",
-        out_dir.display()
-    )]
-    StoppedEarly {
-        /// Ticks completed.
-        ticks: u64,
-        /// Which limit, and by how much.
-        reason: String,
-        /// The run folder.
-        out_dir: PathBuf,
-    },
-    /// The run folder's disk is below the run's reserve (or the folder past its size) before the run starts.
-    #[error("not starting the run: {0}")]
-    NoRoom(String),
-    /// The configuration could not be rewritten as the run used it.
-    #[error("{0}")]
-    AsRun(String),
-    /// The run directory cannot be used.
-    #[error(transparent)]
-    RunDir(#[from] RunDirError),
-    /// The live viewer cannot be served.
-    #[error("--view: {0}")]
-    Viewer(#[from] swarm_viewer::ViewerError),
-    /// A file or process operation failed.
-    #[error("{what}: {source}")]
-    Io {
-        /// What the launcher was doing.
-        what: String,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The world process ended before it was ready or before the experiment finished.
-    #[error("the world process ended ({status}) {when}")]
-    WorldDied {
-        /// Exit status.
-        status: String,
-        /// At which point of the run.
-        when: String,
-    },
-    /// The world did not say `ready` in time.
-    #[error(
-        "the world process did not create its services within {0:?} (limit world_ready_timeout_ms)"
-    )]
-    WorldNotReady(Duration),
-    /// A `--limit` override is invalid.
-    #[error("--limit: {0}")]
-    Limit(#[from] LimitError),
-    /// An agent failed before the first tick.
-    #[error("robot {robot} ({id}) failed to start ({status}):\n{log}")]
-    AgentFailed {
-        /// Robot index.
-        robot: u32,
-        /// Robot id from the configuration.
-        id: String,
-        /// Exit status.
-        status: String,
-        /// The end of the agent's log.
-        log: String,
-    },
-}
-
-fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> LaunchError {
-    let what = what.into();
-    move |source| LaunchError::Io { what, source }
 }
 
 /// Removes every shared-memory file of a run when dropped, whatever happened before.
@@ -745,276 +658,4 @@ struct Supervision {
     agent_exit_grace: Duration,
     /// Progress as log lines when standard error is not a terminal (the bar is drawn only on one).
     plain_progress: Option<PlainProgress>,
-}
-
-impl Supervision {
-    /// Follows the run until the world finishes (or is stopped and finishes), handling deaths, faults,
-    /// restarts and `swarm ctl` requests on the way.
-    fn follow(
-        &mut self,
-        reports: &Receiver<WorldReport>,
-        stop: &AtomicBool,
-    ) -> Result<(), LaunchError> {
-        let mut stop_sent = false;
-        loop {
-            if stop.load(Ordering::Relaxed) && !stop_sent {
-                stop_sent = true;
-                self.interrupted = true;
-                tracing::info!("stopping: the world finishes its tick and flushes its records");
-                self.thaw_all();
-                if let Some(world) = &self.children.world {
-                    children::signal(world, Signal::SIGTERM);
-                }
-            }
-            match reports.recv_timeout(SUPERVISION_PERIOD) {
-                Ok(WorldReport::Tick { tick, dead, .. }) => {
-                    if self.first_tick.is_none() {
-                        self.first_tick = Some(Instant::now());
-                        tracing::info!(after = ?self.started.elapsed(), "first tick completed");
-                    }
-                    self.last_tick = tick;
-                    self.progress.set_position(tick);
-                    let total = self.roster_ids.len() as u32;
-                    if let Some(plain) = &mut self.plain_progress
-                        && let Some(line) = plain.update(tick, total.saturating_sub(dead))
-                    {
-                        tracing::info!("{line}");
-                    }
-                    self.progress.set_message(format!(
-                        "{}/{total} robots alive",
-                        total.saturating_sub(dead)
-                    ));
-                }
-                Ok(WorldReport::Finished { ticks }) => {
-                    tracing::debug!(ticks, "the world finished its records");
-                    self.last_tick = ticks;
-                    self.wait_world()?;
-                    tracing::debug!("the world exited");
-                    return Ok(());
-                }
-                Ok(WorldReport::Fault { tick, kind, robot }) => {
-                    self.on_fault(tick, kind, robot)?;
-                    if kind == FaultKind::KillWorld {
-                        return self.world_killed(tick);
-                    }
-                }
-                Ok(WorldReport::Await { tick }) => self.send_world(WorldCommand::Applied(tick)),
-                Ok(WorldReport::Down { tick, robot, cause }) => self.on_down(tick, robot, cause),
-                Ok(WorldReport::Up { tick, robot }) => self.on_up(tick, robot),
-                Ok(WorldReport::Joined { tick, robot }) => self.on_joined(tick, robot)?,
-                Ok(WorldReport::Refused {
-                    tick,
-                    robot,
-                    reason,
-                }) => self.on_refused(tick, robot, &reason),
-                Ok(WorldReport::Left { tick, robot }) => self.on_left(tick, robot),
-                Ok(WorldReport::Ready { .. }) | Err(RecvTimeoutError::Timeout) => {}
-                Err(RecvTimeoutError::Disconnected) => {
-                    // The world closed its output: it is exiting; its status says how.
-                    self.wait_world()?;
-                    return Err(LaunchError::WorldDied {
-                        status: "without reporting the end of the experiment".into(),
-                        when: format!("after tick {}", self.last_tick),
-                    });
-                }
-            }
-            self.answer_control();
-            self.handle_agent_exits()?;
-            self.start_due_restarts()?;
-        }
-    }
-
-    /// Sends one line to the world (a world that is gone is noticed by the report loop).
-    fn send_world(&mut self, command: WorldCommand) {
-        if let Some(stdin) = self.world_stdin.as_mut() {
-            let _ = writeln!(stdin, "{command}");
-        }
-    }
-
-    /// Reaps exited agents (and takes those `swarm ctl kill` reaped): before the first tick an exit is a failed
-    /// start; afterwards an exit is a death the world hears of at once, unless the agent exited 0 with the run.
-    fn handle_agent_exits(&mut self) -> Result<(), LaunchError> {
-        let mut exits = std::mem::take(&mut self.reaped);
-        exits.extend(self.children.reap_agents());
-        for (robot, status) in exits {
-            // Agents exit 0 when the world has ended the run (its reports, even that of the first tick, may still
-            // be queued), and when they are asked to stop (SIGTERM): that robot leaves the run, and only `always`
-            // restarts it.
-            let left_with_the_run =
-                status.success() && (self.interrupted || transport::run_ended(&self.run));
-            if self.first_tick.is_none()
-                && !left_with_the_run
-                && !self.robots[robot as usize].ctl_killed
-            {
-                let log =
-                    run_dir::tail(&run_dir::agent_log(&self.out_dir, robot), LOG_LINES_QUOTED);
-                return Err(LaunchError::AgentFailed {
-                    robot,
-                    id: self
-                        .roster_ids
-                        .get(robot as usize)
-                        .cloned()
-                        .unwrap_or_default(),
-                    status: status.to_string(),
-                    log,
-                });
-            }
-            if left_with_the_run {
-                continue;
-            }
-            if status.success() {
-                tracing::warn!(robot, tick = self.last_tick, "robot agent left the run");
-            } else {
-                tracing::warn!(robot, %status, tick = self.last_tick, "robot agent died");
-            }
-            let agent = self.robots[robot as usize].pid;
-            self.send_world(WorldCommand::Dead { robot, agent });
-            self.deaths.push(Death {
-                robot,
-                after_tick: self.last_tick,
-                status: status.to_string(),
-            });
-            self.on_exit(robot, status);
-        }
-        Ok(())
-    }
-
-    /// Waits for the world to exit and checks it succeeded.
-    fn wait_world(&mut self) -> Result<(), LaunchError> {
-        let Some(mut world) = self.children.world.take() else {
-            return Ok(());
-        };
-        let status = world.wait().map_err(io("waiting for the world process"))?;
-        if status.success() {
-            Ok(())
-        } else {
-            Err(LaunchError::WorldDied {
-                status: status.to_string(),
-                when: format!("after tick {}", self.last_tick),
-            })
-        }
-    }
-
-    /// Lets agents exit by themselves (the world's end tells them), then kills the rest.
-    fn collect_agents(&mut self) {
-        self.thaw_all();
-        let stragglers = self
-            .children
-            .end_agents(self.agent_exit_grace, EXIT_POLL_PERIOD);
-        if stragglers > 0 {
-            tracing::warn!(stragglers, "agents did not exit after the run; killed them");
-        }
-        tracing::debug!("every agent exited");
-    }
-
-    /// What the run did, for `summary.json` and the caller.
-    fn report(
-        &self,
-        seed: u64,
-        robots: u32,
-        world_pid: u32,
-        agent_pids: Vec<u32>,
-        ticks: u64,
-    ) -> RunReport {
-        RunReport {
-            out_dir: self.out_dir.clone(),
-            seed,
-            robots,
-            ticks,
-            wall_seconds: self.started.elapsed().as_secs_f64(),
-            time_to_first_tick_seconds: self
-                .first_tick
-                .map_or(0.0, |t| t.duration_since(self.started).as_secs_f64()),
-            interrupted: self.interrupted,
-            deaths: self.deaths.clone(),
-            world_pid,
-            agent_pids,
-            faults: self.faults.clone(),
-            alive_final: self.robots[..robots as usize]
-                .iter()
-                .filter(|r| r.is_alive())
-                .count() as u32,
-        }
-    }
-}
-
-/// Adds the launcher's fields to the world's `summary.json` (or writes it if the world wrote none, e.g. because
-/// it died: `world_died` then says why). Returns why the world stopped the run before its end (its disk
-/// budget, `stopped_early`), if it did.
-fn complete_summary(
-    out_dir: &Path,
-    report: &RunReport,
-    provenance: &Provenance,
-    world_died: Option<&str>,
-) -> Result<Option<String>, LaunchError> {
-    let path = out_dir.join(run_dir::SUMMARY_FILE);
-    let mut summary = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .filter(serde_json::Value::is_object)
-        .unwrap_or_else(|| serde_json::json!({}));
-    let deaths: Vec<serde_json::Value> = report
-        .deaths
-        .iter()
-        .map(|d| serde_json::json!({"robot": d.robot, "after_tick": d.after_tick, "status": d.status}))
-        .collect();
-    if let Some(object) = summary.as_object_mut() {
-        object.insert("seed".into(), report.seed.into());
-        object.insert("robots".into(), report.robots.into());
-        object.insert("ticks".into(), report.ticks.into());
-        object.insert("wall_seconds".into(), report.wall_seconds.into());
-        object.insert(
-            "time_to_first_tick_seconds".into(),
-            report.time_to_first_tick_seconds.into(),
-        );
-        object.insert("interrupted".into(), report.interrupted.into());
-        object.insert("deaths".into(), deaths.into());
-        object.insert(
-            "processes".into(),
-            serde_json::json!({"world": report.world_pid, "agents": report.agent_pids}),
-        );
-        let faults: Vec<serde_json::Value> =
-            report.faults.iter().map(FaultRecord::to_json).collect();
-        object.insert("faults".into(), faults.into());
-        object
-            .entry("alive_final")
-            .or_insert(report.alive_final.into());
-        if let Some(reason) = world_died {
-            object.insert("world_died".into(), reason.into());
-        }
-        object.extend(provenance.to_json());
-    }
-    let text = serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n";
-    run_dir::write_atomically(&path, text.as_bytes())
-        .map_err(io(format!("writing {}", path.display())))?;
-    Ok(summary["stopped_early"].as_str().map(str::to_owned))
-}
-
-/// Where a run came from: what was run, by which program, when, from which configuration.
-struct Provenance {
-    command_line: Vec<String>,
-    started_at: SystemTime,
-    config: PathBuf,
-}
-
-impl Provenance {
-    /// The fields `summary.json` gets: `command_line`, `version`, `git_commit` (null when the program was not
-    /// built from a git checkout), `started_at` (RFC 3339, UTC) and `config` (absolute path).
-    fn to_json(&self) -> serde_json::Map<String, serde_json::Value> {
-        let mut fields = serde_json::Map::new();
-        fields.insert("command_line".into(), self.command_line.clone().into());
-        fields.insert("version".into(), env!("CARGO_PKG_VERSION").into());
-        fields.insert(
-            "git_commit".into(),
-            option_env!("SWARM_GIT_COMMIT").map_or(serde_json::Value::Null, Into::into),
-        );
-        fields.insert(
-            "started_at".into(),
-            humantime::format_rfc3339_seconds(self.started_at)
-                .to_string()
-                .into(),
-        );
-        fields.insert("config".into(), self.config.display().to_string().into());
-        fields
-    }
 }
