@@ -1,19 +1,19 @@
-//! `<arena>`: entities (box, cylinder, e-puck, foot-bot, our disc robot and target, light), the floor, and
-//! `<distribute>` blocks.
+//! `<arena>`: entities (box, cylinder, e-puck, foot-bot, our disc robot and target, light); the floor is parsed in
+//! `floor.rs`, `<distribute>` blocks in `distribute.rs`.
 
 use super::{Ctx, MediumRef};
 use crate::bodies::RobotKind;
 use crate::config::faults::At;
 use crate::config::model::{
-    Arena, Arrival, BoxEntity, CylinderEntity, DiscShape, Distribute, Element, Entity, Euler,
-    Floor, FloorRegion, FloorSource, Led, LedGroup, LightEntity, OrientationMethod, PlacedEntity,
-    Pose, PositionMethod, RobotEntity, TargetEntity, Vec3,
+    Arena, Arrival, BoxEntity, CylinderEntity, DiscShape, Element, Entity, Euler, Floor, Led,
+    LedGroup, LightEntity, PlacedEntity, Pose, RobotEntity, TargetEntity, Vec3,
 };
 use crate::config::registry::MediumKind;
 use crate::config::suggest::did_you_mean;
 use crate::messages::{MAX_RANGE_FINDER_RANGE, Rgb};
 
-const ENTITIES: &[&str] = &[
+/// The entities the arena places, by element name (by hand or in a `<distribute>`).
+pub(super) const ENTITIES: &[&str] = &[
     "box",
     "cylinder",
     "e-puck",
@@ -50,8 +50,6 @@ const CAMERA_HEIGHT: f64 = 0.122;
 const _: () = assert!(CAMERA_HEIGHT as f32 == crate::bodies::EPUCK.camera_height);
 /// Default LED height of a `<target>` (docs/tasks.md 4.9: a red LED at 0.06 m).
 const TARGET_LED_HEIGHT: f64 = 0.06;
-/// Default floor resolution when `pixels_per_meter` is absent.
-const PIXELS_PER_METER: f64 = 50.0;
 
 /// Longest arena side accepted, in metres: far beyond any swarm experiment, and small enough that positions keep
 /// millimetre precision in the physics engine's 32-bit floats.
@@ -95,9 +93,9 @@ pub(super) fn arena(ctx: &mut Ctx, el: &Element) -> Option<Arena> {
                     ctx.duplicate(child, &el.name, first.location);
                     continue;
                 }
-                floor = parse_floor(ctx, child);
+                floor = super::floor::parse_floor(ctx, child);
             }
-            "distribute" => distributions.extend(distribute(ctx, child)),
+            "distribute" => distributions.extend(super::distribute::distribute(ctx, child)),
             name if ENTITIES.contains(&name) => entities.extend(placed(ctx, child)),
             name if UNSUPPORTED_ENTITIES.contains(&name) => {
                 ctx.error(
@@ -129,7 +127,7 @@ fn placed(ctx: &mut Ctx, el: &Element) -> Option<PlacedEntity> {
 }
 
 /// Parses an entity. Hand-placed entities need a pose; distribution templates must not have one.
-fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<Entity>) {
+pub(super) fn entity(ctx: &mut Ctx, el: &Element, placed: bool) -> (Option<Pose>, Option<Entity>) {
     let mut pose = None;
     let entity = match el.name.as_str() {
         "light" => {
@@ -603,7 +601,7 @@ fn light(ctx: &mut Ctx, el: &Element) -> Option<LightEntity> {
 }
 
 /// A `color` attribute (mandatory unless a default is given), with a did-you-mean hint for colour names.
-fn color(ctx: &mut Ctx, el: &Element, default: Option<Rgb>) -> Option<Rgb> {
+pub(super) fn color(ctx: &mut Ctx, el: &Element, default: Option<Rgb>) -> Option<Rgb> {
     use crate::config::values::{Value, color_names};
     let Some(attribute) = el.attributes.get("color") else {
         if default.is_none() {
@@ -662,377 +660,6 @@ fn target(ctx: &mut Ctx, el: &Element) -> Option<TargetEntity> {
         medium: medium?,
         location: el.location,
     })
-}
-
-const FLOOR_SOURCES: &[&str] = &["loop_functions", "image", "regions"];
-
-fn parse_floor(ctx: &mut Ctx, el: &Element) -> Option<Floor> {
-    ctx.unknown_attributes(el, &["id", "source", "pixels_per_meter", "path", "color"]);
-    let id: Option<String> = ctx.required(el, "id");
-    let source: Option<String> = ctx.required(el, "source");
-    let pixels_per_meter: f64 = ctx.attr(el, "pixels_per_meter").unwrap_or(PIXELS_PER_METER);
-    let ppm_ok = pixels_per_meter > 0.0 || {
-        let at = el
-            .attributes
-            .get("pixels_per_meter")
-            .map_or(el.location, |a| a.location);
-        ctx.error(
-            at,
-            format!("'pixels_per_meter' in <floor> must be greater than 0, got {pixels_per_meter}"),
-            None,
-        );
-        false
-    };
-    let source = match source.as_deref()? {
-        "regions" => regions(ctx, el)?,
-        other => {
-            for child in &el.children {
-                ctx.error(
-                    child.location,
-                    format!(
-                        "<{}> is not allowed in a <floor source=\"{other}\">",
-                        child.name
-                    ),
-                    (child.name == "region")
-                        .then(|| "use source=\"regions\" to paint regions".to_string()),
-                );
-            }
-            match other {
-                "loop_functions" => FloorSource::LoopFunctions,
-                "image" => FloorSource::Image {
-                    path: ctx.required(el, "path")?,
-                },
-                _ => {
-                    let at = el
-                        .attributes
-                        .get("source")
-                        .map_or(el.location, |a| a.location);
-                    let hint = did_you_mean(other, FLOOR_SOURCES.iter().copied());
-                    ctx.error(at, format!("unknown floor source '{other}' (expected loop_functions, image or regions)"), hint);
-                    return None;
-                }
-            }
-        }
-    };
-    ppm_ok.then_some(())?;
-    Some(Floor {
-        id: id?,
-        source,
-        pixels_per_meter,
-        location: el.location,
-    })
-}
-
-/// `<floor source="regions" color>` with `<region min max color>` children.
-fn regions(ctx: &mut Ctx, el: &Element) -> Option<FloorSource> {
-    let background = color(
-        ctx,
-        el,
-        Some(Rgb {
-            r: 255,
-            g: 255,
-            b: 255,
-        }),
-    );
-    let mut regions = Vec::new();
-    let (children, mut ok) = ctx.children_named(el, "region");
-    for child in children {
-        ctx.unknown_attributes(child, &["min", "max", "color"]);
-        let min = ctx.required(child, "min");
-        let max = ctx.required(child, "max");
-        let color = color(ctx, child, None);
-        let (Some(min), Some(max), Some(color)) = (min, max, color) else {
-            ok = false;
-            continue;
-        };
-        let (min, max): (crate::config::model::Vec2, crate::config::model::Vec2) = (min, max);
-        if min.x > max.x || min.y > max.y {
-            ctx.error(
-                child.location,
-                format!("<region> min '{min}' exceeds max '{max}'"),
-                None,
-            );
-            ok = false;
-            continue;
-        }
-        regions.push(FloorRegion {
-            min,
-            max,
-            color,
-            location: child.location,
-        });
-    }
-    ok.then_some(())?;
-    Some(FloorSource::Regions {
-        background: background?,
-        regions,
-    })
-}
-
-const DISTRIBUTE_CHILDREN: &[&str] = &["position", "orientation", "entity"];
-
-/// Parses `<distribute>`: exactly one `<position>`, `<orientation>` and `<entity>`.
-fn distribute(ctx: &mut Ctx, el: &Element) -> Option<Distribute> {
-    ctx.unknown_attributes(el, &[]);
-    let mut parts: [Option<&Element>; 3] = [None, None, None];
-    for child in &el.children {
-        match DISTRIBUTE_CHILDREN.iter().position(|n| *n == child.name) {
-            Some(i) => match parts[i] {
-                Some(first) => ctx.duplicate(child, &el.name, first.location),
-                None => parts[i] = Some(child),
-            },
-            None => ctx.unknown_element(child, &el.name, DISTRIBUTE_CHILDREN),
-        }
-    }
-    for (part, name) in parts.iter().zip(DISTRIBUTE_CHILDREN) {
-        if part.is_none() {
-            ctx.error(el.location, format!("<distribute> has no <{name}>"), None);
-        }
-    }
-    let [position_el, orientation_el, entity_el] = parts;
-    let position = position_el.and_then(|p| position_method(ctx, p));
-    let orientation = orientation_el.and_then(|o| orientation_method(ctx, o));
-    let entity_el = entity_el?;
-    ctx.unknown_attributes(entity_el, &["quantity", "max_trials", "base_num"]);
-    let quantity: Option<u32> = ctx.required(entity_el, "quantity");
-    let max_trials: Option<u32> = ctx.required(entity_el, "max_trials");
-    let base_num: u32 = ctx.attr(entity_el, "base_num").unwrap_or(0);
-    let template = match entity_el.children.as_slice() {
-        [one] if ENTITIES.contains(&one.name.as_str()) => entity(ctx, one, false).1,
-        [one] => {
-            let hint = did_you_mean(&one.name, ENTITIES.iter().copied());
-            ctx.error(
-                one.location,
-                format!("<{}> cannot be distributed", one.name),
-                hint,
-            );
-            None
-        }
-        children => {
-            ctx.error(
-                entity_el.location,
-                format!(
-                    "<entity> must contain exactly one entity template, found {}",
-                    children.len()
-                ),
-                None,
-            );
-            None
-        }
-    };
-    let (position, quantity) = (position?, quantity?);
-    if let PositionMethod::Grid { layout, .. } = &position {
-        let cells = layout.iter().map(|&n| u64::from(n)).product::<u64>();
-        if u64::from(quantity) > cells {
-            let at = entity_el
-                .attributes
-                .get("quantity")
-                .map_or(entity_el.location, |a| a.location);
-            ctx.error(
-                at,
-                format!(
-                    "quantity {quantity} exceeds the grid layout's {}x{}x{} = {cells} cells",
-                    layout[0], layout[1], layout[2]
-                ),
-                None,
-            );
-            return None;
-        }
-    }
-    Some(Distribute {
-        position,
-        orientation: orientation?,
-        quantity,
-        max_trials: max_trials?,
-        base_num,
-        template: template?,
-        location: el.location,
-        position_location: position_el.map_or(el.location, |p| p.location),
-        orientation_location: orientation_el.map_or(el.location, |o| o.location),
-        entity_location: entity_el.location,
-    })
-}
-
-const POSITION_METHODS: &[&str] = &["uniform", "gaussian", "constant", "grid"];
-const ORIENTATION_METHODS: &[&str] = &["uniform", "gaussian", "constant"];
-
-/// The `method` attribute, checked against `methods`.
-fn method<'a>(ctx: &mut Ctx, el: &'a Element, methods: &[&str]) -> Option<&'a str> {
-    let Some(attribute) = el.attributes.get("method") else {
-        ctx.error(
-            el.location,
-            format!("<{}> is missing the attribute 'method'", el.name),
-            None,
-        );
-        return None;
-    };
-    let method = attribute.value.trim();
-    if methods.contains(&method) {
-        return Some(method);
-    }
-    let hint = if method == "grid" {
-        Some("grid places positions only".to_string())
-    } else {
-        did_you_mean(method, methods.iter().copied())
-    };
-    ctx.error(
-        attribute.location,
-        format!(
-            "unknown {} method '{method}' (expected {})",
-            el.name,
-            methods.join(", ")
-        ),
-        hint,
-    );
-    None
-}
-
-fn position_method(ctx: &mut Ctx, el: &Element) -> Option<PositionMethod> {
-    let method = method(ctx, el, POSITION_METHODS)?;
-    let generator = match method {
-        "uniform" => {
-            ctx.unknown_attributes(el, &["method", "min", "max"]);
-            let (min, max) = (ctx.required(el, "min"), ctx.required(el, "max"));
-            let (min, max): (Vec3, Vec3) = (min?, max?);
-            uniform_bounds(
-                ctx,
-                el,
-                [min.x, min.y, min.z],
-                [max.x, max.y, max.z],
-                &min.to_string(),
-                &max.to_string(),
-            )?;
-            PositionMethod::Uniform { min, max }
-        }
-        "gaussian" => {
-            ctx.unknown_attributes(el, &["method", "mean", "std_dev"]);
-            let (mean, std_dev) = (ctx.required(el, "mean"), ctx.required(el, "std_dev"));
-            let (mean, std_dev): (Vec3, Vec3) = (mean?, std_dev?);
-            non_negative_std_dev(ctx, el, [std_dev.x, std_dev.y, std_dev.z])?;
-            PositionMethod::Gaussian { mean, std_dev }
-        }
-        "constant" => {
-            ctx.unknown_attributes(el, &["method", "values"]);
-            PositionMethod::Constant {
-                values: ctx.required(el, "values")?,
-            }
-        }
-        _ => {
-            ctx.unknown_attributes(el, &["method", "center", "distances", "layout"]);
-            let center = ctx.required(el, "center");
-            let distances = ctx.required(el, "distances");
-            let layout: Option<[u32; 3]> = ctx.required(el, "layout");
-            let layout = layout.filter(|l| {
-                let ok = l.iter().all(|&n| n >= 1);
-                if !ok {
-                    let at = el
-                        .attributes
-                        .get("layout")
-                        .map_or(el.location, |a| a.location);
-                    ctx.error(
-                        at,
-                        format!(
-                            "grid 'layout' needs at least 1 cell along each axis, got {},{},{}",
-                            l[0], l[1], l[2]
-                        ),
-                        None,
-                    );
-                }
-                ok
-            });
-            PositionMethod::Grid {
-                center: center?,
-                distances: distances?,
-                layout: layout?,
-            }
-        }
-    };
-    Some(generator)
-}
-
-fn orientation_method(ctx: &mut Ctx, el: &Element) -> Option<OrientationMethod> {
-    let method = method(ctx, el, ORIENTATION_METHODS)?;
-    let generator = match method {
-        "uniform" => {
-            ctx.unknown_attributes(el, &["method", "min", "max"]);
-            let (min, max) = (ctx.required(el, "min"), ctx.required(el, "max"));
-            let (min, max): (Euler, Euler) = (min?, max?);
-            let text = |e: Euler| format!("{},{},{}", e.z_deg, e.y_deg, e.x_deg);
-            uniform_bounds(
-                ctx,
-                el,
-                [min.z_deg, min.y_deg, min.x_deg],
-                [max.z_deg, max.y_deg, max.x_deg],
-                &text(min),
-                &text(max),
-            )?;
-            OrientationMethod::Uniform { min, max }
-        }
-        "gaussian" => {
-            ctx.unknown_attributes(el, &["method", "mean", "std_dev"]);
-            let (mean, std_dev) = (ctx.required(el, "mean"), ctx.required(el, "std_dev"));
-            let (mean, std_dev): (Euler, Euler) = (mean?, std_dev?);
-            non_negative_std_dev(ctx, el, [std_dev.z_deg, std_dev.y_deg, std_dev.x_deg])?;
-            OrientationMethod::Gaussian { mean, std_dev }
-        }
-        _ => {
-            ctx.unknown_attributes(el, &["method", "values"]);
-            OrientationMethod::Constant {
-                values: ctx.required(el, "values")?,
-            }
-        }
-    };
-    Some(generator)
-}
-
-/// `uniform` needs min <= max in every component (a component with min = max is constant).
-fn uniform_bounds(
-    ctx: &mut Ctx,
-    el: &Element,
-    min: [f64; 3],
-    max: [f64; 3],
-    min_text: &str,
-    max_text: &str,
-) -> Option<()> {
-    let axes = if el.name == "orientation" {
-        ["z", "y", "x"]
-    } else {
-        ["x", "y", "z"]
-    };
-    let bad: Vec<&str> = (0..3)
-        .filter(|&i| min[i] > max[i])
-        .map(|i| axes[i])
-        .collect();
-    if bad.is_empty() {
-        return Some(());
-    }
-    let at = el.attributes.get("min").map_or(el.location, |a| a.location);
-    ctx.error(
-        at,
-        format!(
-            "uniform {} min '{min_text}' exceeds max '{max_text}' in {}",
-            el.name,
-            bad.join(", ")
-        ),
-        None,
-    );
-    None
-}
-
-fn non_negative_std_dev(ctx: &mut Ctx, el: &Element, std_dev: [f64; 3]) -> Option<()> {
-    if std_dev.iter().all(|&s| s >= 0.0) {
-        return Some(());
-    }
-    let at = el
-        .attributes
-        .get("std_dev")
-        .map_or(el.location, |a| a.location);
-    ctx.error(
-        at,
-        format!("gaussian {} 'std_dev' must not be negative", el.name),
-        None,
-    );
-    None
 }
 
 /// How messages name an entity, e.g. `<e-puck> 'ep0'`.

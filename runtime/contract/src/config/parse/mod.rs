@@ -9,7 +9,9 @@ mod arena;
 mod checks;
 mod controllers;
 mod coordinators;
+mod distribute;
 mod engines;
+mod floor;
 mod framework;
 
 use std::path::{Path, PathBuf};
