@@ -1,25 +1,7 @@
 use super::*;
 use crate::automaton::ModelKind;
 
-/// The generator of the worked example in section 9, with normalised probabilities.
-fn worked_example() -> (EventTable, Automaton) {
-    let mut ev = EventTable::new();
-    let a = ev.intern("a", true).unwrap();
-    let b = ev.intern("b", true).unwrap();
-    let c = ev.intern("c", true).unwrap();
-    let u = ev.intern("u", false).unwrap();
-    let mut g = Automaton::new("example", ModelKind::Supervisor);
-    let q0 = g.add_state("q0", true).unwrap();
-    let q1 = g.add_state("q1", false).unwrap();
-    let q2 = g.add_state("q2", false).unwrap();
-    g.add_transition(q0, a, q1, 0.8, 2).unwrap();
-    g.add_transition(q0, b, q2, 0.2, 0).unwrap();
-    g.add_transition(q1, a, q1, 1.0, 0).unwrap();
-    g.add_transition(q1, u, q0, 1.0, 0).unwrap();
-    g.add_transition(q2, b, q0, 0.25, 0).unwrap();
-    g.add_transition(q2, c, q1, 0.75, 0).unwrap();
-    (ev, g)
-}
+include!("../../tests/shared/section9_example.rs");
 
 /// The arrays of the worked example, as printed in section 9.
 const WORKED_DELTA: [u8; 21] = [
@@ -51,7 +33,7 @@ fn worked_payload() -> Vec<u8> {
 
 #[test]
 fn worked_example_of_section_9_gives_the_thesis_bytes_and_memcons_57() {
-    let (ev, g) = worked_example();
+    let (ev, g) = section9_example();
     let set = SupervisorSet::from_supervisors(&ev, std::slice::from_ref(&g)).unwrap();
     let bytes = set.to_bytes();
     let payload = worked_payload();
@@ -67,7 +49,7 @@ fn worked_example_of_section_9_gives_the_thesis_bytes_and_memcons_57() {
 
 #[test]
 fn initial_state_is_renumbered_to_zero() {
-    let (ev, mut g) = worked_example();
+    let (ev, mut g) = section9_example();
     g.set_initial(StateId(2)).unwrap();
     let set = SupervisorSet::from_supervisors(&ev, &[g]).unwrap();
     let s = &set.supervisors[0];
@@ -101,7 +83,7 @@ fn uncontrollable_transitions_are_stored_after_controllable_ones() {
 
 #[test]
 fn v15_lower_bound_over_65535_is_a_codegen_error() {
-    let (ev, mut g) = worked_example();
+    let (ev, mut g) = section9_example();
     g.transitions_mut(StateId(0))[0].lower_bound = 70_000;
     assert!(matches!(
         SupervisorSet::from_supervisors(&ev, &[g]),
@@ -139,7 +121,7 @@ fn v15_more_than_255_transitions_in_a_state_is_a_codegen_error() {
 
 #[test]
 fn raw_weight_above_one_cannot_be_encoded() {
-    let (ev, mut g) = worked_example();
+    let (ev, mut g) = section9_example();
     g.transitions_mut(StateId(2))[1].prob = 3.0;
     assert!(matches!(
         SupervisorSet::from_supervisors(&ev, &[g]),
@@ -148,7 +130,7 @@ fn raw_weight_above_one_cannot_be_encoded() {
 }
 
 fn worked_bytes() -> Vec<u8> {
-    let (ev, g) = worked_example();
+    let (ev, g) = section9_example();
     SupervisorSet::from_supervisors(&ev, &[g])
         .unwrap()
         .to_bytes()
@@ -235,7 +217,7 @@ fn read_errors_name_the_file() {
     let msg = SupervisorSet::read(&path).unwrap_err().to_string();
     assert!(msg.contains("bad.ptsc") && msg.contains("byte 4"), "{msg}");
     let ok = dir.path().join("ok.ptsc");
-    let (ev, g) = worked_example();
+    let (ev, g) = section9_example();
     let set = SupervisorSet::from_supervisors(&ev, &[g]).unwrap();
     set.write(&ok).unwrap();
     assert_eq!(SupervisorSet::read(&ok).unwrap(), set);

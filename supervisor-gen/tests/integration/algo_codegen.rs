@@ -16,23 +16,11 @@ mod generated {
 
 const GOLDEN: &str = "tests/integration/algo_generated/worked_example.rs";
 
-/// The section 9 worked example with normalised probabilities.
+include!("../shared/section9_example.rs");
+
+/// The section 9 worked example compiled.
 fn worked_example() -> SupervisorSet {
-    let mut ev = EventTable::new();
-    let a = ev.intern("a", true).unwrap();
-    let b = ev.intern("b", true).unwrap();
-    let c = ev.intern("c", true).unwrap();
-    let u = ev.intern("u", false).unwrap();
-    let mut g = Automaton::new("example", ModelKind::Supervisor);
-    let q0 = g.add_state("q0", true).unwrap();
-    let q1 = g.add_state("q1", false).unwrap();
-    let q2 = g.add_state("q2", false).unwrap();
-    g.add_transition(q0, a, q1, 0.8, 2).unwrap();
-    g.add_transition(q0, b, q2, 0.2, 0).unwrap();
-    g.add_transition(q1, a, q1, 1.0, 0).unwrap();
-    g.add_transition(q1, u, q0, 1.0, 0).unwrap();
-    g.add_transition(q2, b, q0, 0.25, 0).unwrap();
-    g.add_transition(q2, c, q1, 0.75, 0).unwrap();
+    let (ev, g) = section9_example();
     SupervisorSet::from_supervisors(&ev, &[g]).unwrap()
 }
 
