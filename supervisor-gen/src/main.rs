@@ -9,27 +9,27 @@ use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod drawing;
+mod synth_output;
 mod terminal_progress;
+
+use drawing::{Drawer, draw_synthesis};
+use synth_output::{print_summary, supervisors_xml, write_compiled, write_models};
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use supervisor_gen::architecture::Architecture;
-use supervisor_gen::automaton::{Automaton, EventTable, ModelKind, StateId};
+use supervisor_gen::automaton::ModelKind;
 use supervisor_gen::build::{BuildError, BuildRequest, Built, Synthesised, build, synthesise};
 use supervisor_gen::codegen::generate_rust;
 use supervisor_gen::convert::to_automata;
 use supervisor_gen::diagnostics::{Diagnostic, Severity};
-use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels, StateMark};
+use supervisor_gen::dot::{self, ImageFormat, Images, ProbLabels};
 use supervisor_gen::load::{Input, load};
-use supervisor_gen::pipeline::{SupervisorSynthesis, Synthesis};
-use supervisor_gen::reduce::{
-    ReduceLimits, Reduction, ReductionOutcome, SupervisorReduction, reduce_synthesis,
-};
+use supervisor_gen::reduce::{ReduceLimits, reduce_synthesis};
 use supervisor_gen::report::{ReductionFiles, Report, SkippedOutput};
-use supervisor_gen::supc::RemovalReason;
 use supervisor_gen::validate::{CheckedModel, ValidateOptions};
-use supervisor_gen::xml_write::write_xml;
 
 /// ptSCT toolchain: validate plant and specification automata, synthesise, minimise, draw and compile supervisors.
 ///
@@ -463,114 +463,8 @@ fn synth(args: &SynthArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// The XML files `synth` writes, relative to the output directory.
-struct XmlFiles {
-    /// One per supervisor, the one compiled: `<S>.xml`.
-    supervisors: Vec<String>,
-    /// One per reduction computed (with `--reduce`): `<S>.reduced.xml`.
-    reduced: Vec<String>,
-    /// One per plant observer (with `--reduce`): `observer_<plant>.xml`.
-    observers: Vec<String>,
-}
-
-/// The supervisors (reduced where a reduction is used), every reduction and the observers, each with its file.
-fn supervisors_xml<'a>(
-    synthesis: &'a Synthesis,
-    reduction: Option<&'a Reduction>,
-) -> (XmlFiles, Vec<(String, &'a Automaton)>) {
-    let mut models = Vec::new();
-    let mut named = |automata: Vec<&'a Automaton>, prefix: &str, suffix: &str| -> Vec<String> {
-        automata
-            .into_iter()
-            .map(|a| {
-                let file = format!("{prefix}{}{suffix}.xml", dot::file_stem(a.name()));
-                models.push((file.clone(), a));
-                file
-            })
-            .collect()
-    };
-    let files = match reduction {
-        None => XmlFiles {
-            supervisors: named(
-                synthesis
-                    .supervisors
-                    .iter()
-                    .map(|s| &s.supervisor)
-                    .collect(),
-                "",
-                "",
-            ),
-            reduced: Vec::new(),
-            observers: Vec::new(),
-        },
-        Some(r) => XmlFiles {
-            supervisors: named(
-                r.supervisors.iter().map(|s| s.supervisor()).collect(),
-                "",
-                "",
-            ),
-            reduced: named(
-                r.supervisors
-                    .iter()
-                    .filter_map(|s| s.reduced.as_ref())
-                    .collect(),
-                "",
-                ".reduced",
-            ),
-            observers: named(r.observers.iter().collect(), "observer_", ""),
-        },
-    };
-    (files, models)
-}
-
-/// Writes `supervisors.ptsct` and `supervisors.rs` of the set (the reduced one with `--reduce`), or notes in
-/// `skipped` why they were not; returns the bytes written and the set's MemCons.
-fn write_compiled(
-    args: &SynthArgs,
-    synthesis: &Synthesis,
-    reduction: Option<&Reduction>,
-    skipped: &mut Vec<SkippedOutput>,
-) -> Result<(usize, usize)> {
-    let compiled = match reduction {
-        Some(r) => r.compile(&synthesis.normalised.events),
-        None => synthesis.compile(),
-    };
-    match compiled {
-        Ok(set) => {
-            let bytes = set.to_bytes();
-            write(&args.out.join("supervisors.ptsct"), &bytes)?;
-            let origin = origin(&args.project, synthesis.architecture, args.reduce);
-            write(
-                &args.out.join("supervisors.rs"),
-                generate_rust(&set, &origin),
-            )?;
-            Ok((bytes.len(), set.mem_cons()))
-        }
-        Err(err) => {
-            for output in ["supervisors.ptsct", "supervisors.rs"] {
-                skipped.push(SkippedOutput {
-                    output: output.to_owned(),
-                    reason: format!("V15: {err}"),
-                });
-            }
-            Ok((
-                0,
-                reduction.map_or(synthesis.mem_cons, |r| r.mem_cons_after),
-            ))
-        }
-    }
-}
-
-/// Writes each automaton to its file in `out`.
-fn write_models(out: &Path, models: &[(String, &Automaton)], events: &EventTable) -> Result<()> {
-    for (file, a) in models {
-        write_with(&out.join(file), |w| write_xml(a, events, w))?;
-    }
-    Ok(())
-}
-
 /// A one-line description of the inputs for the generated module's header.
-fn origin(args: &ProjectArgs, architecture: Architecture, reduce: bool) -> String {
+pub(crate) fn origin(args: &ProjectArgs, architecture: Architecture, reduce: bool) -> String {
     let names = |paths: &[PathBuf]| {
         paths
             .iter()
@@ -591,226 +485,12 @@ fn origin(args: &ProjectArgs, architecture: Architecture, reduce: bool) -> Strin
     )
 }
 
-fn print_summary(
-    synthesis: &Synthesis,
-    reduction: Option<&Reduction>,
-    mem_cons: usize,
-    out: &Path,
-) {
-    for s in &synthesis.supervisors {
-        println!(
-            "{}: {} states, {} transitions ({} controllable), {} events; {} state(s) of K removed",
-            s.name,
-            s.stats.states,
-            s.stats.transitions,
-            s.stats.controllable_transitions,
-            s.stats.events,
-            s.removed.len()
-        );
-    }
-    if let Some(nc) = &synthesis.non_conflict {
-        if nc.nonblocking {
-            println!("non-conflict: the supervisors are nonblocking together");
-        } else {
-            println!(
-                "warning: the supervisors conflict: {} blocking product state(s), e.g. {}",
-                nc.blocking_count,
-                nc.blocking_states.join(", ")
-            );
-        }
-    }
-    if let Some(v) = &synthesis.local_modular_validation {
-        if v.passed() {
-            println!(
-                "local-modular validation: the local supervisors equal the monolithic supervisor"
-            );
-        } else {
-            println!(
-                "warning: local-modular validation failed: see report.json (architecture_checks)"
-            );
-        }
-    }
-    match reduction {
-        Some(r) => {
-            print_reduction(r);
-            println!(
-                "MemCons {mem_cons} bytes ({} unreduced); outputs in {}",
-                r.mem_cons_before,
-                out.display()
-            );
-        }
-        None => println!("MemCons {mem_cons} bytes; outputs in {}", out.display()),
-    }
-}
-
-/// One line per supervisor of a reduction, its observers and its warnings.
-fn print_reduction(reduction: &Reduction) {
-    for s in &reduction.supervisors {
-        let Some(reduced) = &s.reduced else {
-            println!("reduction: {} not reduced (see the warning)", s.name);
-            continue;
-        };
-        let what = match &s.outcome {
-            ReductionOutcome::Reduced => "reduced",
-            ReductionOutcome::NoGain => "kept, its reduction is no smaller",
-            ReductionOutcome::ObserversCostMore => {
-                "kept, the plant observers its reduction needs cost more"
-            }
-            ReductionOutcome::Skipped { .. } => "kept",
-        };
-        println!(
-            "reduction: {} {what}: {} -> {} states, {} -> {} transitions",
-            s.name,
-            s.original.state_count(),
-            reduced.state_count(),
-            s.original.transition_count(),
-            reduced.transition_count(),
-        );
-    }
-    if !reduction.observers.is_empty() {
-        let names: Vec<&str> = reduction.observers.iter().map(Automaton::name).collect();
-        println!(
-            "reduction: plant observers run with the reduced supervisors: {}",
-            names.join(", ")
-        );
-    }
-    println!(
-        "reduction: each reduction checked against the unreduced closed loop (language, marking, P, T, timers)"
-    );
-    for w in reduction.warnings() {
-        eprintln!("warning: {w}");
-    }
-}
-
-/// Draws the project's inputs (once, into `inputs/`), every intermediate stage of every supervisor (into
-/// `stages/`) and the final supervisors (at the top, apart from the rest).
-fn draw_synthesis(
-    drawer: &mut Drawer<'_>,
-    synthesis: &Synthesis,
-    reduction: Option<&Reduction>,
-) -> Result<()> {
-    let project = &synthesis.normalised;
-    for a in project.plants.iter().chain(&project.specs) {
-        let stem = format!("inputs/{}", dot::file_stem(a.name()));
-        drawer.draw(&stem, a, &HashMap::new(), ProbLabels::Stored)?;
-    }
-    for (i, s) in synthesis.supervisors.iter().enumerate() {
-        draw_stages(drawer, s, reduction.map(|r| &r.supervisors[i]))?;
-    }
-    if let Some(s) = &synthesis.monolithic_reference {
-        draw_stages(drawer, s, None)?;
-    }
-    for o in reduction.iter().flat_map(|r| &r.observers) {
-        let stem = format!("observer_{}", dot::file_stem(o.name()));
-        drawer.draw(&stem, o, &HashMap::new(), ProbLabels::Stored)?;
-    }
-    Ok(())
-}
-
-/// G, E, K (with the removed states marked), SupC before minimisation, with a reduction the minimised supervisor
-/// and its reduction (`_5_minimised`, `_6_reduced`), and the final supervisor (the one compiled).
-fn draw_stages(
-    drawer: &mut Drawer<'_>,
-    s: &SupervisorSynthesis,
-    reduction: Option<&SupervisorReduction>,
-) -> Result<()> {
-    let stem = dot::file_stem(&s.name);
-    let removed: HashMap<StateId, StateMark> = s
-        .removed
-        .iter()
-        .map(|r| match r.reason {
-            RemovalReason::Bad { .. } => (r.state, StateMark::Bad),
-            _ => (r.state, StateMark::Removed),
-        })
-        .collect();
-    let none = HashMap::new();
-    // K is kept only when drawing (`keep_targets`).
-    let target = s.target.as_ref().map(|k| ("3_K", k, &removed));
-    let inputs = [("1_G", &s.plant, &none), ("2_E", &s.spec, &none)];
-    let supc = ("4_supc", &s.unminimised, &none);
-    let minimised = reduction.map(|_| ("5_minimised", &s.supervisor, &none));
-    let reduced = reduction
-        .and_then(|r| r.reduced.as_ref())
-        .map(|a| ("6_reduced", a, &none));
-    let stages = inputs
-        .into_iter()
-        .chain(target)
-        .chain([supc])
-        .chain(minimised)
-        .chain(reduced);
-    for (stage, automaton, marks) in stages {
-        drawer.draw(
-            &format!("stages/{stem}_{stage}"),
-            automaton,
-            marks,
-            ProbLabels::Stored,
-        )?;
-    }
-    let last = reduction.map_or(&s.supervisor, SupervisorReduction::supervisor);
-    drawer.draw(&stem, last, &none, ProbLabels::Stored)?;
-    Ok(())
-}
-
-/// Writes drawings of automata over one event table into one directory, and notes the drawings it leaves out.
-struct Drawer<'a> {
-    dir: &'a Path,
-    events: &'a EventTable,
-    images: Images,
-    /// Drawings (or their images) not written because the automaton is too large, relative to `dir`.
-    skipped: Vec<SkippedOutput>,
-}
-
-impl Drawer<'_> {
-    /// Writes one drawing; returns the number of files written. An automaton of more than
-    /// [`dot::MAX_DOT_STATES`] states is not drawn, and one of more than [`dot::MAX_IMAGE_STATES`] gets its DOT
-    /// file but no images: both are noted in `skipped`.
-    fn draw(
-        &mut self,
-        stem: &str,
-        a: &Automaton,
-        marks: &HashMap<StateId, StateMark>,
-        probs: ProbLabels,
-    ) -> Result<usize> {
-        let states = a.state_count();
-        if states > dot::MAX_DOT_STATES {
-            self.skipped.push(SkippedOutput {
-                output: format!("{stem}.dot"),
-                reason: format!(
-                    "{states} states, more than the {} drawn at all",
-                    dot::MAX_DOT_STATES
-                ),
-            });
-            return Ok(0);
-        }
-        let text = dot::to_dot(a, self.events, marks, probs);
-        let no_images = Images {
-            formats: Vec::new(),
-            dpi: None,
-        };
-        let images = if states > dot::MAX_IMAGE_STATES && !self.images.formats.is_empty() {
-            self.skipped.push(SkippedOutput {
-                output: format!("{stem} images"),
-                reason: format!(
-                    "{states} states, more than the {} Graphviz is asked to lay out; the DOT file is written",
-                    dot::MAX_IMAGE_STATES
-                ),
-            });
-            &no_images
-        } else {
-            &self.images
-        };
-        let written = dot::write_drawing(self.dir, stem, &text, images)
-            .with_context(|| format!("cannot write drawing {stem} in {}", self.dir.display()))?;
-        Ok(written.len())
-    }
-}
-
-fn create_dir(dir: &Path) -> Result<()> {
+pub(crate) fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
 }
 
 /// Writes a file through a buffer as `contents` produces it.
-fn write_with(
+pub(crate) fn write_with(
     path: &Path,
     contents: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<()> {
@@ -821,6 +501,6 @@ fn write_with(
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+pub(crate) fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
     std::fs::write(path, contents).with_context(|| format!("cannot write {}", path.display()))
 }
