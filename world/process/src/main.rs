@@ -225,14 +225,15 @@ fn run(args: &WorldArgs, hosts: &HostsArgs) -> anyhow::Result<()> {
     // The agents' CPU accounts (a `/proc` file each, about 10 ms at 1,000 robots) are read while the record files
     // are completed: both must be done before the agents are let go, and the records mostly wait for the
     // recording thread.
-    let cpu_end = cpu.map(|cpu| cpu.end(&link, robot_steps));
+    let ticks = link.tick();
+    let cpu = cpu.map(|cpu| (cpu.same_agents(&link), cpu));
     let (cpu, records) = std::thread::scope(|scope| {
-        let reading = scope.spawn(|| cpu_end.map(|end| end.summary()));
+        let reading = scope
+            .spawn(|| cpu.map(|(same_agents, cpu)| cpu.summary(ticks, robot_steps, same_agents)));
         let records = recorder.complete_records();
         (reading.join().ok().flatten(), records)
     });
     records?;
-    let ticks = link.tick();
     let mut extra = serde_json::json!({
         "robot_steps": robot_steps,
         "commands_missing": commands_missing,

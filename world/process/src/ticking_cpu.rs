@@ -37,43 +37,25 @@ impl TickingCpu {
         })
     }
 
-    /// What [`TickingCpu::summary`] needs of the link after `robot_steps` answered steps in all, taken on the
-    /// world's thread so that the reading itself can run on another (`Link` stays on its thread).
-    pub fn end(self, link: &Link, robot_steps: u64) -> TickingCpuEnd {
-        let same_agents = match link {
+    /// Whether the agents of `link` are still the ones marked (none was replaced); read on the world's thread,
+    /// where the link stays.
+    pub fn same_agents(&self, link: &Link) -> bool {
+        match link {
             Link::Local(local) => local.agent_pids() == self.agents,
             Link::Remote(_) => false,
-        };
-        TickingCpuEnd {
-            start: self,
-            ticks: link.tick(),
-            robot_steps,
-            same_agents,
         }
     }
-}
 
-/// The end of the ticking phase, ready to be read ([`TickingCpu::end`]).
-pub struct TickingCpuEnd {
-    start: TickingCpu,
-    ticks: u64,
-    robot_steps: u64,
-    same_agents: bool,
-}
-
-impl TickingCpuEnd {
-    /// The figures for summary.json: `cpu_world_us_per_tick` and, when no agent was replaced,
-    /// `cpu_agents_us_per_robot_step`, both since the mark. Reads every agent's accounts: call it before the
-    /// agents exit.
-    pub fn summary(&self) -> serde_json::Value {
-        let start = &self.start;
-        let robot_steps = self.robot_steps.saturating_sub(start.first_steps);
-        let ticks = self.ticks.saturating_sub(start.first_tick) as f64;
-        let world = start.world_mark.per_step_of([std::process::id()], ticks);
-        let agents = self.same_agents.then(|| {
-            start
-                .agents_mark
-                .per_step_of(start.agents.iter().copied(), robot_steps as f64)
+    /// The figures for summary.json at tick `tick` after `robot_steps` answered steps in all:
+    /// `cpu_world_us_per_tick` and, when `same_agents`, `cpu_agents_us_per_robot_step`, both since the mark.
+    /// Reads every agent's accounts: call it before the agents exit.
+    pub fn summary(&self, tick: u64, robot_steps: u64, same_agents: bool) -> serde_json::Value {
+        let robot_steps = robot_steps.saturating_sub(self.first_steps);
+        let ticks = tick.saturating_sub(self.first_tick) as f64;
+        let world = self.world_mark.per_step_of([std::process::id()], ticks);
+        let agents = same_agents.then(|| {
+            self.agents_mark
+                .per_step_of(self.agents.iter().copied(), robot_steps as f64)
                 .as_secs_f64()
                 * 1e6
         });
