@@ -1,7 +1,7 @@
 use super::*;
 use crate::automaton::ModelKind;
 
-include!("../../tests/shared/section9_example.rs");
+include!("../../tests/common/section9_example.rs");
 
 /// The arrays of the worked example, as printed in section 9.
 const WORKED_DELTA: [u8; 21] = [

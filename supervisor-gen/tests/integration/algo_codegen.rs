@@ -16,7 +16,7 @@ mod generated {
 
 const GOLDEN: &str = "tests/integration/algo_generated/worked_example.rs";
 
-include!("../shared/section9_example.rs");
+include!("../common/section9_example.rs");
 
 /// The section 9 worked example compiled.
 fn worked_example() -> SupervisorSet {
